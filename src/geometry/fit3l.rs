@@ -1,0 +1,467 @@
+//! Fitting implicit polynomials to measured points.
+//!
+//! - 3L (seed 003 section 2; Lei, Blane, Cooper, PAMI 2000): besides the data (target 0), two offset copies along
+//!   the outward normals, at +c outside (target +c) and -c inside (target -c), so that F approximates the signed
+//!   distance near the data. Here c is chosen per point: it starts at a fraction of the data's RMS radius and is
+//!   halved until the offset point's nearest data point is its own point, so that an offset never reaches past the
+//!   medial axis of a thin section (the opposite face of a trailing edge a few tenths of a millimetre away).
+//! - ridge-regularised 3L (Tasdizen, Tarel, Cooper, IEEE TIP 2000): the same system with a penalty on the
+//!   coefficients, weighted so that it is invariant to rotations of the data (the weights of the Bombieri norm,
+//!   scaled by the data's moments), which keeps spurious branches away from the data.
+//! - orthogonal-distance refinement: Levenberg-Marquardt (Gauss-Newton with damping) on the exact distances of the
+//!   points to the zero set, started from the ridge answer, with the same regulariser.
+//!
+//! Every system is solved by Householder QR of the stacked matrix, never by normal equations. The data are
+//! normalised first (centroid, unit RMS radius) and the normalisation is stored with the model.
+
+use nalgebra::{DMatrix, DVector, SVector};
+use serde::{Deserialize, Serialize};
+
+use super::distance::{crosses_zero_set, lagrange_newton, ExactDistance};
+use super::implicit::{Frame, IpModel};
+use super::nearest::PointIndex;
+use super::poly::{factorial, Basis, Poly, MAX_DEGREE};
+use super::sampling::{project_to_zero_set, Aabb, ZeroSetSamples};
+use super::small;
+
+/// Largest 3L offset, as a fraction of the data's RMS radius (it only shrinks from there).
+const MAX_OFFSET: f64 = 0.03;
+/// An offset point must be at least this fraction of its offset away from every other data point.
+const OFFSET_CLEARANCE: f64 = 0.98;
+const OFFSET_HALVINGS: usize = 12;
+const ODR_MAX_ITERATIONS: usize = 60;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum FitMethod {
+    /// Plain 3L, as in seed 003 (to reproduce the paper).
+    #[serde(rename = "3l")]
+    ThreeL,
+    /// Ridge-regularised 3L.
+    #[serde(rename = "ridge")]
+    Ridge,
+    /// Ridge-regularised 3L refined by orthogonal distances: the most accurate (see BENCHMARKS.md).
+    #[serde(rename = "odr")]
+    #[default]
+    Orthogonal,
+}
+
+impl FitMethod {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::ThreeL => "3L (Lei-Blane-Cooper), as in seed 003",
+            Self::Ridge => "ridge-regularised 3L (Tasdizen-Tarel-Cooper)",
+            Self::Orthogonal => "ridge-regularised 3L refined by orthogonal distances (Levenberg-Marquardt)",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitOptions {
+    pub degree: usize,
+    pub method: FitMethod,
+    /// Ridge weight relative to one data row; the default is measured in BENCHMARKS.md.
+    pub ridge: f64,
+    /// Grid cells along the longest side of the box in which the zero set is sampled for the statistics.
+    pub sampling_cells: usize,
+}
+
+impl FitOptions {
+    pub fn new(degree: usize, method: FitMethod) -> Self {
+        Self {
+            degree,
+            method,
+            ridge: 1e-5,
+            sampling_cells: if degree > 0 { 512 } else { 1 },
+        }
+    }
+}
+
+/// How good a fit is, in millimetres; returned with every model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitStats {
+    pub points: usize,
+    /// RMS of the exact distances of the fitted points to the zero set.
+    pub rms_distance_mm: f64,
+    pub max_distance_mm: f64,
+    /// Where the largest distance is: the fitted point's coordinates.
+    pub max_distance_at: Vec<f64>,
+    /// Condition number (largest over smallest singular value) of the least-squares system that was solved.
+    pub condition_number: f64,
+    /// Connected components of the zero set inside twice the data's bounding box: 1 for a clean closed profile;
+    /// more means a spurious branch near the data.
+    pub zero_set_components: usize,
+    /// The range of 3L offsets used, mm.
+    pub offset_min_mm: f64,
+    pub offset_max_mm: f64,
+    /// Levenberg-Marquardt iterations of the orthogonal refinement (0 for the other methods).
+    pub refinement_iterations: usize,
+    /// Points whose exact distance could not be computed (a defect of the model near them).
+    pub points_without_foot: usize,
+}
+
+/// A fitted model with its statistics.
+#[derive(Debug, Clone)]
+pub struct Fitted<const N: usize> {
+    pub model: IpModel<N>,
+    pub method: FitMethod,
+    pub stats: FitStats,
+    /// The box in which the model was fitted and sampled (the data's bounding box), mm.
+    pub domain: Aabb<N>,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FitError {
+    #[error("degree {degree} is not supported (1 to {MAX_DEGREE})")]
+    BadDegree { degree: usize },
+    #[error("{got} points are too few for a degree-{degree} fit (it has {unknowns} coefficients; give at least {needed} points)")]
+    TooFewPoints {
+        got: usize,
+        degree: usize,
+        unknowns: usize,
+        needed: usize,
+    },
+    #[error("the points do not span {dims} dimensions (they lie on a {what}); a fit needs a {dims}-D spread")]
+    Degenerate { dims: usize, what: &'static str },
+    #[error("{normals} normals were given for {points} points")]
+    NormalCount { points: usize, normals: usize },
+    #[error("the least-squares system is singular (too few distinct points for this degree)")]
+    Singular,
+}
+
+/// Fits an implicit polynomial to `points` (mm) with outward unit `normals`.
+pub fn fit_ip<const N: usize>(
+    points: &[SVector<f64, N>],
+    normals: &[SVector<f64, N>],
+    options: &FitOptions,
+) -> Result<Fitted<N>, FitError> {
+    let degree = options.degree;
+    if degree == 0 || degree > MAX_DEGREE {
+        return Err(FitError::BadDegree { degree });
+    }
+    if normals.len() != points.len() {
+        return Err(FitError::NormalCount {
+            points: points.len(),
+            normals: normals.len(),
+        });
+    }
+    let basis = Basis::<N>::new(degree);
+    // Three rows per point; with fewer points than unknowns the data rows alone leave the shape undetermined.
+    if points.len() < basis.len() {
+        return Err(FitError::TooFewPoints {
+            got: points.len(),
+            degree,
+            unknowns: basis.len(),
+            needed: basis.len(),
+        });
+    }
+    check_spread(points)?;
+    let frame = Frame::of_points(points).ok_or(FitError::Degenerate {
+        dims: N,
+        what: "single point",
+    })?;
+    let unit: Vec<SVector<f64, N>> = points.iter().map(|p| frame.to_unit(p)).collect();
+    let offsets = choose_offsets(&unit, normals);
+    let ridge = match options.method {
+        FitMethod::ThreeL => None,
+        FitMethod::Ridge | FitMethod::Orthogonal => Some(ridge_weights(&basis, &unit, options.ridge)),
+    };
+    let (coeffs, condition_number) = solve_three_level(&basis, &unit, normals, &offsets, ridge.as_deref())?;
+    let mut poly = Poly::new(degree, coeffs);
+    let mut refinement_iterations = 0;
+    if options.method == FitMethod::Orthogonal {
+        let weights = ridge.expect("the orthogonal method is regularised");
+        if let Some((refined, iterations)) = refine_orthogonal(&poly, &unit, &weights) {
+            poly = refined;
+            refinement_iterations = iterations;
+        }
+    }
+    let model = IpModel { frame, poly };
+    let domain = Aabb::of_points(points).expect("points are not empty");
+    let (min_offset, max_offset) = offsets
+        .iter()
+        .flat_map(|o| [o.inside, o.outside])
+        .flatten()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), c| (lo.min(c), hi.max(c)));
+    let mut stats = measure(&model, points, &domain, options.sampling_cells);
+    stats.condition_number = condition_number;
+    stats.offset_min_mm = min_offset * frame.scale;
+    stats.offset_max_mm = max_offset * frame.scale;
+    stats.refinement_iterations = refinement_iterations;
+    Ok(Fitted {
+        model,
+        method: options.method,
+        stats,
+        domain,
+    })
+}
+
+/// Rejects point sets that lie on a line (2-D) or a plane (3-D): their spread has a vanishing direction.
+fn check_spread<const N: usize>(points: &[SVector<f64, N>]) -> Result<(), FitError> {
+    let mean = points.iter().sum::<SVector<f64, N>>() / points.len() as f64;
+    let covariance = points
+        .iter()
+        .map(|p| (p - mean) * (p - mean).transpose())
+        .fold(nalgebra::SMatrix::<f64, N, N>::zeros(), |a, b| a + b);
+    let eigen = small::symmetric_eigen(&covariance);
+    let smallest = eigen[0].0;
+    let largest = eigen[N - 1].0;
+    if largest <= 0.0 || smallest <= largest * 1e-18 {
+        let what = match N {
+            2 => "straight line",
+            _ => "plane",
+        };
+        return Err(FitError::Degenerate { dims: N, what });
+    }
+    Ok(())
+}
+
+/// The 3L offsets of one point, in normalised units; `None` where no safe offset exists on that side.
+#[derive(Debug, Clone, Copy)]
+struct Offsets {
+    inside: Option<f64>,
+    outside: Option<f64>,
+}
+
+fn choose_offsets<const N: usize>(unit: &[SVector<f64, N>], normals: &[SVector<f64, N>]) -> Vec<Offsets> {
+    let index = PointIndex::new(unit);
+    let safe = |i: usize, direction: f64| -> Option<f64> {
+        let mut c = MAX_OFFSET;
+        for _ in 0..OFFSET_HALVINGS {
+            let offset_point = unit[i] + normals[i] * (direction * c);
+            let nearest = index.nearest(&offset_point)?;
+            if nearest == i || (offset_point - unit[nearest]).norm() >= OFFSET_CLEARANCE * c {
+                return Some(c);
+            }
+            c /= 2.0;
+        }
+        None
+    };
+    (0..unit.len())
+        .map(|i| Offsets {
+            inside: safe(i, -1.0),
+            outside: safe(i, 1.0),
+        })
+        .collect()
+}
+
+/// Ridge penalty per coefficient: kappa * rows * beta_|e| * (prod e_k!) / |e|!, with beta_k the mean of |u|^(2k)
+/// over the data. The factorial ratio makes sum w a^2 a rotation-invariant norm of each homogeneous part.
+fn ridge_weights<const N: usize>(basis: &Basis<N>, unit: &[SVector<f64, N>], kappa: f64) -> Vec<f64> {
+    let moments: Vec<f64> = (0..=basis.degree())
+        .map(|k| unit.iter().map(|u| u.norm_squared().powi(k as i32)).sum::<f64>() / unit.len() as f64)
+        .collect();
+    let rows = 3.0 * unit.len() as f64;
+    basis
+        .exponents()
+        .iter()
+        .map(|e| {
+            let total: usize = e.iter().map(|&x| x as usize).sum();
+            let ratio = e.iter().map(|&x| factorial(x as usize)).product::<f64>() / factorial(total);
+            kappa * rows * moments[total] * ratio
+        })
+        .collect()
+}
+
+/// Builds and solves the (regularised) 3L system. Returns the coefficients and the condition number.
+fn solve_three_level<const N: usize>(
+    basis: &Basis<N>,
+    unit: &[SVector<f64, N>],
+    normals: &[SVector<f64, N>],
+    offsets: &[Offsets],
+    ridge: Option<&[f64]>,
+) -> Result<(Vec<f64>, f64), FitError> {
+    let mut rows: Vec<(SVector<f64, N>, f64)> = Vec::with_capacity(3 * unit.len());
+    for ((u, n), o) in unit.iter().zip(normals).zip(offsets) {
+        rows.push((*u, 0.0));
+        if let Some(c) = o.inside {
+            rows.push((u - n * c, -c));
+        }
+        if let Some(c) = o.outside {
+            rows.push((u + n * c, c));
+        }
+    }
+    let m = basis.len();
+    let extra = if ridge.is_some() { m } else { 0 };
+    let mut a = DMatrix::<f64>::zeros(rows.len() + extra, m);
+    let mut b = DVector::<f64>::zeros(rows.len() + extra);
+    let mut row = vec![0.0; m];
+    for (i, (u, target)) in rows.iter().enumerate() {
+        basis.monomials_into(u, &mut row);
+        a.row_mut(i).copy_from_slice(&row);
+        b[i] = *target;
+    }
+    if let Some(weights) = ridge {
+        for (j, w) in weights.iter().enumerate() {
+            a[(rows.len() + j, j)] = w.sqrt();
+        }
+    }
+    least_squares(a, b).ok_or(FitError::Singular)
+}
+
+/// Solves min |A x - b| by Householder QR. Returns x and the condition number of A.
+fn least_squares(a: DMatrix<f64>, mut b: DVector<f64>) -> Option<(Vec<f64>, f64)> {
+    let m = a.ncols();
+    let qr = a.qr();
+    qr.q_tr_mul(&mut b);
+    let r = qr.r();
+    let singular = r.clone().singular_values();
+    let (largest, smallest) = (singular.max(), singular.min());
+    if smallest <= largest * 1e-15 || !largest.is_finite() {
+        return None;
+    }
+    let x = r.solve_upper_triangular(&b.rows(0, m))?;
+    Some((x.iter().copied().collect(), largest / smallest))
+}
+
+/// Current foot points of the data in normalised coordinates, refreshed for each trial model.
+struct Feet<const N: usize> {
+    points: Vec<SVector<f64, N>>,
+    distances: Vec<f64>,
+}
+
+/// Feet of every data point on `poly`'s zero set, each started from `starts` (the previous feet) and checked.
+/// `None` when some point has no foot: the candidate model is then rejected as a step.
+fn feet_of<const N: usize>(poly: &Poly<N>, unit: &[SVector<f64, N>], starts: &[SVector<f64, N>]) -> Option<Feet<N>> {
+    let mut points = Vec::with_capacity(unit.len());
+    let mut distances = Vec::with_capacity(unit.len());
+    for (u, start) in unit.iter().zip(starts) {
+        let foot = lagrange_newton(poly, u, start).filter(|f| !crosses_zero_set(poly, u, &f.point))?;
+        points.push(foot.point);
+        distances.push(foot.distance);
+    }
+    Some(Feet { points, distances })
+}
+
+/// Levenberg-Marquardt on the exact distances. Returns the refined polynomial and the iteration count, or `None`
+/// when the starting model is too far from the data for foot points to be found (the ridge answer then stands).
+fn refine_orthogonal<const N: usize>(
+    start: &Poly<N>,
+    unit: &[SVector<f64, N>],
+    weights: &[f64],
+) -> Option<(Poly<N>, usize)> {
+    let projected: Vec<SVector<f64, N>> = unit
+        .iter()
+        .map(|u| project_to_zero_set(start, u, 0.5))
+        .collect::<Option<_>>()?;
+    let mut poly = normalise_gradient(start.clone(), &projected);
+    let mut feet = feet_of(&poly, unit, &projected)?;
+    let objective = |poly: &Poly<N>, feet: &Feet<N>| -> f64 {
+        feet.distances.iter().map(|d| d * d).sum::<f64>()
+            + poly.coeffs().iter().zip(weights).map(|(a, w)| w * a * a).sum::<f64>()
+    };
+    let mut current = objective(&poly, &feet);
+    let mut damping: f64 = 1e-3;
+    let m = poly.coeffs().len();
+    let n = unit.len();
+    let mut row = vec![0.0; m];
+    let mut iterations = 0;
+    while iterations < ODR_MAX_ITERATIONS {
+        iterations += 1;
+        // Rows: distances (J_i = m(f_i) / |grad P(f_i)|), ridge, a gauge row that forbids a pure change of scale
+        // (P and lambda P have the same zero set), and the damping rows.
+        let mut jac = DMatrix::<f64>::zeros(n + m + 1, m);
+        let mut rhs = DVector::<f64>::zeros(n + m + 1 + m);
+        for i in 0..n {
+            let (_, g) = poly.value_gradient(&feet.points[i]);
+            poly.basis().monomials_into(&feet.points[i], &mut row);
+            let gn = g.norm();
+            for j in 0..m {
+                jac[(i, j)] = row[j] / gn;
+            }
+            rhs[i] = -feet.distances[i];
+        }
+        let coeffs = DVector::from_column_slice(poly.coeffs());
+        for j in 0..m {
+            jac[(n + j, j)] = weights[j].sqrt();
+            rhs[n + j] = -weights[j].sqrt() * coeffs[j];
+        }
+        let gauge = coeffs.normalize() * (n as f64).sqrt();
+        jac.row_mut(n + m).copy_from(&gauge.transpose());
+        let mut accepted = false;
+        for _ in 0..12 {
+            let mut system = jac.clone().insert_rows(n + m + 1, m, 0.0);
+            for j in 0..m {
+                system[(n + m + 1 + j, j)] = damping.sqrt() * jac.column(j).norm().max(1e-12);
+            }
+            let Some((step, _)) = least_squares(system, rhs.clone()) else {
+                damping *= 10.0;
+                continue;
+            };
+            let candidate_coeffs: Vec<f64> = coeffs.iter().zip(&step).map(|(a, s)| a + s).collect();
+            let candidate = Poly::new(poly.degree(), candidate_coeffs);
+            let candidate = normalise_gradient(candidate, &feet.points);
+            if let Some(candidate_feet) = feet_of(&candidate, unit, &feet.points) {
+                let value = objective(&candidate, &candidate_feet);
+                if value < current {
+                    let improvement = (current - value) / current.max(f64::MIN_POSITIVE);
+                    poly = candidate;
+                    feet = candidate_feet;
+                    current = value;
+                    damping = (damping / 3.0).max(1e-12);
+                    accepted = true;
+                    if improvement < 1e-10 {
+                        return Some((poly, iterations));
+                    }
+                    break;
+                }
+            }
+            damping *= 5.0;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    Some((poly, iterations))
+}
+
+/// Rescales P so that its gradient has unit RMS length at the given points (P is then distance-like near them).
+fn normalise_gradient<const N: usize>(mut poly: Poly<N>, at: &[SVector<f64, N>]) -> Poly<N> {
+    let mean_square = at.iter().map(|p| poly.value_gradient(p).1.norm_squared()).sum::<f64>() / at.len() as f64;
+    let factor = 1.0 / mean_square.sqrt();
+    if factor.is_finite() {
+        poly.coeffs_mut().iter_mut().for_each(|c| *c *= factor);
+    }
+    poly
+}
+
+/// Fit statistics of a world-coordinate model against the points it was fitted to.
+fn measure<const N: usize>(
+    model: &IpModel<N>,
+    points: &[SVector<f64, N>],
+    domain: &Aabb<N>,
+    cells: usize,
+) -> FitStats {
+    let samples = ZeroSetSamples::new(model, &domain.scaled(2.0), cells);
+    let exact = ExactDistance::new(model, &samples);
+    let mut sum_squares = 0.0;
+    let mut max = (0.0f64, points[0]);
+    let mut failed = 0;
+    let mut counted = 0;
+    for (p, foot) in points.iter().zip(exact.feet_along_scan(points)) {
+        match foot {
+            Ok(foot) => {
+                counted += 1;
+                sum_squares += foot.distance * foot.distance;
+                if foot.distance.abs() > max.0 {
+                    max = (foot.distance.abs(), *p);
+                }
+            }
+            Err(_) => failed += 1,
+        }
+    }
+    FitStats {
+        points: points.len(),
+        rms_distance_mm: (sum_squares / counted.max(1) as f64).sqrt(),
+        max_distance_mm: max.0,
+        max_distance_at: max.1.iter().copied().collect(),
+        condition_number: f64::NAN,
+        zero_set_components: samples.components(),
+        offset_min_mm: 0.0,
+        offset_max_mm: 0.0,
+        refinement_iterations: 0,
+        points_without_foot: failed,
+    }
+}
+
+#[cfg(test)]
+mod tests;

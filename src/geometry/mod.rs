@@ -1,0 +1,12 @@
+//! The geometry kernel: pure mathematics, no I/O. Implicit polynomials, their fitting, distances to their zero
+//! sets and profile interpolation. Nothing here imports from the station.
+
+pub mod distance;
+pub mod fit3l;
+pub mod implicit;
+pub mod interp;
+pub mod nearest;
+pub mod normals;
+pub mod poly;
+pub mod sampling;
+pub mod small;

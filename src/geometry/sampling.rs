@@ -1,0 +1,289 @@
+//! A sampled zero set: F evaluated on a regular grid over a box, the cells where F changes sign, their connected
+//! components (a spurious branch near the data shows up as an extra component), and points projected onto the zero
+//! set from those cells (seeds for the exact distance, so that Newton starts on the near side of a thin section).
+
+use nalgebra::SVector;
+
+use super::implicit::Implicit;
+use super::nearest::PointIndex;
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb<const N: usize> {
+    pub min: SVector<f64, N>,
+    pub max: SVector<f64, N>,
+}
+
+impl<const N: usize> Aabb<N> {
+    /// The bounding box of the points; `None` for no points.
+    pub fn of_points(points: &[SVector<f64, N>]) -> Option<Self> {
+        let first = points.first()?;
+        Some(points.iter().fold(
+            Self {
+                min: *first,
+                max: *first,
+            },
+            |b, p| Self {
+                min: b.min.inf(p),
+                max: b.max.sup(p),
+            },
+        ))
+    }
+
+    /// The box with the same centre and every side multiplied by `factor`.
+    pub fn scaled(&self, factor: f64) -> Self {
+        let center = (self.min + self.max) / 2.0;
+        let half = (self.max - self.min) / 2.0 * factor;
+        Self {
+            min: center - half,
+            max: center + half,
+        }
+    }
+
+    pub fn diagonal(&self) -> f64 {
+        (self.max - self.min).norm()
+    }
+}
+
+/// The zero set of F sampled over a box.
+pub struct ZeroSetSamples<const N: usize> {
+    points: Vec<SVector<f64, N>>,
+    index: PointIndex<N>,
+    components: usize,
+    cell_size: f64,
+}
+
+impl<const N: usize> ZeroSetSamples<N> {
+    /// Samples F over `bounds` with `cells` grid cells along the longest side (cubic cells).
+    pub fn new(f: &impl Implicit<N>, bounds: &Aabb<N>, cells: usize) -> Self {
+        let extent = bounds.max - bounds.min;
+        let side = extent.max() / cells as f64;
+        let counts: [usize; N] = std::array::from_fn(|k| ((extent[k] / side).ceil() as usize).max(1));
+        Self::with_counts(f, bounds, counts)
+    }
+
+    /// Samples F over `bounds` with `counts[k]` cells along axis k (cells may be elongated: a blade surface that
+    /// varies slowly along the profile axis needs few cells along it).
+    pub fn with_counts(f: &impl Implicit<N>, bounds: &Aabb<N>, counts: [usize; N]) -> Self {
+        let extent = bounds.max - bounds.min;
+        let cell = SVector::<f64, N>::from_fn(|k, _| extent[k].max(f64::MIN_POSITIVE) / counts[k] as f64);
+        let cell_size = cell.max();
+        let grid = Grid {
+            origin: bounds.min,
+            cell,
+            counts,
+        };
+        let signs = grid.corner_signs(f);
+        let crossing = grid.crossing_cells(&signs);
+        let components = grid.count_components(&crossing);
+        let points: Vec<_> = crossing
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c)
+            .filter_map(|(index, _)| project_to_zero_set(f, &grid.cell_center(index), 1.5 * cell.norm()))
+            .collect();
+        let index = PointIndex::new(&points);
+        Self {
+            points,
+            index,
+            components,
+            cell_size,
+        }
+    }
+
+    /// The longest side of a grid cell: seeds are within about this of the zero set's nearest point.
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// Connected components of the zero set inside the box (cells joined through shared faces).
+    pub fn components(&self) -> usize {
+        self.components
+    }
+
+    pub fn points(&self) -> &[SVector<f64, N>] {
+        &self.points
+    }
+
+    /// Samples by increasing distance from `p`.
+    pub fn nearest_iter(&self, p: &SVector<f64, N>) -> impl Iterator<Item = SVector<f64, N>> + '_ {
+        self.index.nearest_iter(p).map(|i| self.points[i])
+    }
+}
+
+/// Moves `start` onto the zero set along the gradient (Newton's projection), giving up after `max_travel`.
+pub fn project_to_zero_set<const N: usize>(
+    f: &impl Implicit<N>,
+    start: &SVector<f64, N>,
+    max_travel: f64,
+) -> Option<SVector<f64, N>> {
+    let mut x = *start;
+    for _ in 0..30 {
+        let (v, g) = f.value_gradient(&x);
+        let g2 = g.norm_squared();
+        if g2 == 0.0 || !g2.is_finite() {
+            return None;
+        }
+        let step = g * (v / g2);
+        x -= step;
+        if (x - start).norm() > max_travel {
+            return None;
+        }
+        if step.norm() <= 1e-12 * (1.0 + x.norm()) {
+            return Some(x);
+        }
+    }
+    None
+}
+
+struct Grid<const N: usize> {
+    origin: SVector<f64, N>,
+    cell: SVector<f64, N>,
+    counts: [usize; N],
+}
+
+impl<const N: usize> Grid<N> {
+    fn corner_counts(&self) -> [usize; N] {
+        std::array::from_fn(|k| self.counts[k] + 1)
+    }
+
+    fn corner_signs(&self, f: &impl Implicit<N>) -> Vec<bool> {
+        let counts = self.corner_counts();
+        let total: usize = counts.iter().product();
+        (0..total)
+            .map(|i| {
+                let idx = unflatten(i, &counts);
+                let p = self.origin
+                    + SVector::<f64, N>::from_fn(|k, _| idx[k] as f64 * self.cell[k]);
+                f.value(&p) > 0.0
+            })
+            .collect()
+    }
+
+    fn cell_count(&self) -> usize {
+        self.counts.iter().product()
+    }
+
+    fn crossing_cells(&self, signs: &[bool]) -> Vec<bool> {
+        let corners = self.corner_counts();
+        (0..self.cell_count())
+            .map(|cell| {
+                let idx = unflatten(cell, &self.counts);
+                let mut seen = [false; 2];
+                for corner in 0..(1usize << N) {
+                    let c: [usize; N] = std::array::from_fn(|k| idx[k] + ((corner >> k) & 1));
+                    seen[signs[flatten(&c, &corners)] as usize] = true;
+                }
+                seen[0] && seen[1]
+            })
+            .collect()
+    }
+
+    fn count_components(&self, crossing: &[bool]) -> usize {
+        let mut sets = DisjointSets::new(crossing.len());
+        for cell in (0..crossing.len()).filter(|&c| crossing[c]) {
+            let idx = unflatten(cell, &self.counts);
+            for k in 0..N {
+                if idx[k] + 1 < self.counts[k] {
+                    let mut next = idx;
+                    next[k] += 1;
+                    let other = flatten(&next, &self.counts);
+                    if crossing[other] {
+                        sets.union(cell, other);
+                    }
+                }
+            }
+        }
+        (0..crossing.len())
+            .filter(|&c| crossing[c] && sets.find(c) == c)
+            .count()
+    }
+
+    fn cell_center(&self, cell: usize) -> SVector<f64, N> {
+        let idx = unflatten(cell, &self.counts);
+        self.origin + SVector::<f64, N>::from_fn(|k, _| (idx[k] as f64 + 0.5) * self.cell[k])
+    }
+}
+
+fn unflatten<const N: usize>(mut i: usize, counts: &[usize; N]) -> [usize; N] {
+    std::array::from_fn(|k| {
+        let v = i % counts[k];
+        i /= counts[k];
+        v
+    })
+}
+
+fn flatten<const N: usize>(idx: &[usize; N], counts: &[usize; N]) -> usize {
+    (0..N).rev().fold(0, |acc, k| acc * counts[k] + idx[k])
+}
+
+/// Union-find with path halving.
+struct DisjointSets {
+    parent: Vec<usize>,
+}
+
+impl DisjointSets {
+    fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n).collect(),
+        }
+    }
+
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            self.parent[ra] = rb;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::poly::Poly;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn two_circles_are_two_components_and_samples_lie_on_them() {
+        // (x^2 + y^2 - 1) * ((x - 3)^2 + y^2 - 1) has two unit circles centred at 0 and 3.
+        // Expanded: product of (x^2 + y^2 - 1) and (x^2 - 6x + 8 + y^2).
+        let a = Poly::<2>::new(2, vec![-1.0, 0.0, 0.0, 1.0, 0.0, 1.0]);
+        let b = Poly::<2>::new(2, vec![8.0, -6.0, 0.0, 1.0, 0.0, 1.0]);
+        struct Product(Poly<2>, Poly<2>);
+        impl Implicit<2> for Product {
+            fn value_gradient(&self, p: &Vector2<f64>) -> (f64, Vector2<f64>) {
+                let (va, ga) = self.0.value_gradient(p);
+                let (vb, gb) = self.1.value_gradient(p);
+                (va * vb, ga * vb + gb * va)
+            }
+            fn value_gradient_hessian(
+                &self,
+                _: &Vector2<f64>,
+            ) -> (f64, Vector2<f64>, nalgebra::Matrix2<f64>) {
+                unreachable!("sampling needs no Hessian")
+            }
+        }
+        let f = Product(a, b);
+        let bounds = Aabb {
+            min: Vector2::new(-2.0, -2.0),
+            max: Vector2::new(5.0, 2.0),
+        };
+        let samples = ZeroSetSamples::new(&f, &bounds, 140);
+        assert_eq!(samples.components(), 2);
+        assert!(samples.points().len() > 200);
+        for p in samples.points() {
+            let r = p.norm().min((p - Vector2::new(3.0, 0.0)).norm());
+            assert!((r - 1.0).abs() < 1e-9, "sample {p} is off both circles");
+        }
+        let near = samples.nearest_iter(&Vector2::new(3.0, 1.5)).next().unwrap();
+        assert!((near - Vector2::new(3.0, 1.0)).norm() < 0.06);
+    }
+}
