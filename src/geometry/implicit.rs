@@ -59,8 +59,11 @@ impl<const N: usize> Frame<N> {
             return None;
         }
         let center = points.iter().sum::<SVector<f64, N>>() / points.len() as f64;
-        let mean_square =
-            points.iter().map(|p| (p - center).norm_squared()).sum::<f64>() / points.len() as f64;
+        let mean_square = points
+            .iter()
+            .map(|p| (p - center).norm_squared())
+            .sum::<f64>()
+            / points.len() as f64;
         let scale = mean_square.sqrt();
         (scale > 0.0 && scale.is_finite()).then_some(Self { center, scale })
     }

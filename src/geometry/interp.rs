@@ -27,7 +27,9 @@ pub struct Profile {
 pub enum StackError {
     #[error("a stack needs at least two profiles, got {0}")]
     TooFewProfiles(usize),
-    #[error("profiles at x = {0} mm and x = {1} mm coincide; profiles must be at distinct positions")]
+    #[error(
+        "profiles at x = {0} mm and x = {1} mm coincide; profiles must be at distinct positions"
+    )]
     SamePosition(f64, f64),
     #[error("profiles have different degrees ({0} and {1}); fit every profile of a stack at the same degree")]
     MixedDegrees(usize, usize),
@@ -53,13 +55,23 @@ impl ProfileStack {
                 return Err(StackError::SamePosition(pair[0].x, pair[1].x));
             }
             if pair[0].model.degree() != pair[1].model.degree() {
-                return Err(StackError::MixedDegrees(pair[0].model.degree(), pair[1].model.degree()));
+                return Err(StackError::MixedDegrees(
+                    pair[0].model.degree(),
+                    pair[1].model.degree(),
+                ));
             }
         }
         let n = profiles.len() as f64;
-        let center_yz = profiles.iter().map(|p| p.model.frame.center).sum::<Vector2<f64>>() / n;
+        let center_yz = profiles
+            .iter()
+            .map(|p| p.model.frame.center)
+            .sum::<Vector2<f64>>()
+            / n;
         let center_x = profiles.iter().map(|p| p.x).sum::<f64>() / n;
-        let scale = profiles.iter().map(|p| p.model.frame.scale).fold(0.0, f64::max);
+        let scale = profiles
+            .iter()
+            .map(|p| p.model.frame.scale)
+            .fold(0.0, f64::max);
         let frame_yz = Frame {
             center: center_yz,
             scale,
@@ -68,7 +80,10 @@ impl ProfileStack {
             center: Vector3::new(center_x, center_yz.x, center_yz.y),
             scale,
         };
-        let common: Vec<Poly<2>> = profiles.iter().map(|p| p.model.reframed(frame_yz).poly).collect();
+        let common: Vec<Poly<2>> = profiles
+            .iter()
+            .map(|p| p.model.reframed(frame_yz).poly)
+            .collect();
         let segments = (0..profiles.len() - 1)
             .map(|k| {
                 let ua = (profiles[k].x - center_x) / scale;
@@ -131,11 +146,22 @@ fn blend(a: &Poly<2>, ua: f64, b: &Poly<2>, ub: f64) -> Poly<3> {
     let degree = a.degree() + 1;
     let mut out = Poly::<3>::zero(degree);
     let span = ub - ua;
-    for (e, (ca, cb)) in a.basis().exponents().iter().zip(a.coeffs().iter().zip(b.coeffs())) {
+    for (e, (ca, cb)) in a
+        .basis()
+        .exponents()
+        .iter()
+        .zip(a.coeffs().iter().zip(b.coeffs()))
+    {
         let alpha = (ca * ub - cb * ua) / span;
         let beta = (cb - ca) / span;
-        let constant_in_x = out.basis().index_of(&[0, e[0], e[1]]).expect("within degree");
-        let linear_in_x = out.basis().index_of(&[1, e[0], e[1]]).expect("within degree");
+        let constant_in_x = out
+            .basis()
+            .index_of(&[0, e[0], e[1]])
+            .expect("within degree");
+        let linear_in_x = out
+            .basis()
+            .index_of(&[1, e[0], e[1]])
+            .expect("within degree");
         out.coeffs_mut()[constant_in_x] += alpha;
         out.coeffs_mut()[linear_in_x] += beta;
     }
@@ -188,11 +214,31 @@ mod tests {
 
     #[test]
     fn segments_reproduce_their_profiles_and_blend_linearly() {
-        let a = circle_model(Vector2::new(0.0, 0.0), 10.0, Frame { center: Vector2::new(1.0, 2.0), scale: 7.0 });
-        let b = circle_model(Vector2::new(3.0, 1.0), 14.0, Frame { center: Vector2::new(-2.0, 0.5), scale: 9.0 });
+        let a = circle_model(
+            Vector2::new(0.0, 0.0),
+            10.0,
+            Frame {
+                center: Vector2::new(1.0, 2.0),
+                scale: 7.0,
+            },
+        );
+        let b = circle_model(
+            Vector2::new(3.0, 1.0),
+            14.0,
+            Frame {
+                center: Vector2::new(-2.0, 0.5),
+                scale: 9.0,
+            },
+        );
         let stack = ProfileStack::new(vec![
-            Profile { x: 200.0, model: b.clone() },
-            Profile { x: 100.0, model: a.clone() },
+            Profile {
+                x: 200.0,
+                model: b.clone(),
+            },
+            Profile {
+                x: 100.0,
+                model: a.clone(),
+            },
         ])
         .unwrap();
         assert_eq!(stack.profiles()[0].x, 100.0, "profiles are sorted along x");
@@ -206,6 +252,10 @@ mod tests {
             let mid = stack.value(&Vector3::new(125.0, y, z));
             assert!((mid - (0.75 * fa + 0.25 * fb)).abs() < 1e-9 * (1.0 + fa.abs() + fb.abs()));
         }
-        assert_eq!(stack.segment_model(0).degree(), 3, "a quadratic profile blends into a cubic");
+        assert_eq!(
+            stack.segment_model(0).degree(),
+            3,
+            "a quadratic profile blends into a cubic"
+        );
     }
 }

@@ -10,3 +10,4 @@ pub mod normals;
 pub mod poly;
 pub mod sampling;
 pub mod small;
+pub mod trace;

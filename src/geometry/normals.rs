@@ -55,7 +55,11 @@ fn least_spread_direction<const N: usize>(
     points: &[SVector<f64, N>],
     neighbours: &[usize],
 ) -> SVector<f64, N> {
-    let mean = neighbours.iter().map(|&j| points[j]).sum::<SVector<f64, N>>() / neighbours.len() as f64;
+    let mean = neighbours
+        .iter()
+        .map(|&j| points[j])
+        .sum::<SVector<f64, N>>()
+        / neighbours.len() as f64;
     let covariance = neighbours
         .iter()
         .map(|&j| {
@@ -96,10 +100,11 @@ fn orient<const N: usize>(
     let centroid = points.iter().sum::<SVector<f64, N>>() / n as f64;
     let mut visited = vec![false; n];
     // Each pass orients one connected patch of the neighbour graph from its own extreme point.
-    while let Some(start) = (0..n)
-        .filter(|&i| !visited[i])
-        .max_by(|&a, &b| (points[a] - centroid).norm().total_cmp(&(points[b] - centroid).norm()))
-    {
+    while let Some(start) = (0..n).filter(|&i| !visited[i]).max_by(|&a, &b| {
+        (points[a] - centroid)
+            .norm()
+            .total_cmp(&(points[b] - centroid).norm())
+    }) {
         if normals[start].dot(&(points[start] - centroid)) < 0.0 {
             normals[start] = -normals[start];
         }
@@ -145,7 +150,9 @@ mod tests {
     fn circle(n: usize, clockwise: bool) -> Vec<Vector2<f64>> {
         (0..n)
             .map(|i| {
-                let t = i as f64 / n as f64 * std::f64::consts::TAU * if clockwise { -1.0 } else { 1.0 };
+                let t = i as f64 / n as f64
+                    * std::f64::consts::TAU
+                    * if clockwise { -1.0 } else { 1.0 };
                 Vector2::new(3.0 + 2.0 * t.cos(), -1.0 + 2.0 * t.sin())
             })
             .collect()
@@ -157,7 +164,10 @@ mod tests {
             let pts = circle(50, clockwise);
             for (p, n) in pts.iter().zip(ordered_profile_normals(&pts)) {
                 let radial = (p - Vector2::new(3.0, -1.0)).normalize();
-                assert!(n.dot(&radial) > 0.999, "clockwise={clockwise}: {n} vs {radial}");
+                assert!(
+                    n.dot(&radial) > 0.999,
+                    "clockwise={clockwise}: {n} vs {radial}"
+                );
             }
         }
     }
@@ -184,6 +194,11 @@ mod tests {
             .filter(|(p, normal)| normal.dot(&p.normalize()) < 0.99)
             .map(|(p, n)| (p.normalize(), n))
             .collect();
-        assert!(wrong.is_empty(), "{} wrong, first {:?}", wrong.len(), wrong.first());
+        assert!(
+            wrong.is_empty(),
+            "{} wrong, first {:?}",
+            wrong.len(),
+            wrong.first()
+        );
     }
 }

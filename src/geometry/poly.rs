@@ -21,7 +21,10 @@ impl<const N: usize> Basis<N> {
     /// The basis of all monomials of total degree `<= degree`. Panics above [`MAX_DEGREE`] (a programming error:
     /// user-facing code checks the degree first).
     pub fn new(degree: usize) -> Self {
-        assert!(degree <= MAX_DEGREE, "degree {degree} exceeds the maximum {MAX_DEGREE}");
+        assert!(
+            degree <= MAX_DEGREE,
+            "degree {degree} exceeds the maximum {MAX_DEGREE}"
+        );
         let mut exponents = Vec::with_capacity(Self::len_for(degree));
         for total in 0..=degree {
             push_exponents_of_total::<N>(total, 0, [0; N], &mut exponents);
@@ -167,7 +170,11 @@ impl<const N: usize> Poly<N> {
             .exponents
             .iter()
             .zip(&self.coeffs)
-            .map(|(e, c)| c * (0..N).map(|k| powers.value[k][e[k] as usize]).product::<f64>())
+            .map(|(e, c)| {
+                c * (0..N)
+                    .map(|k| powers.value[k][e[k] as usize])
+                    .product::<f64>()
+            })
             .sum()
     }
 
@@ -326,7 +333,10 @@ mod tests {
         );
         assert_eq!(Basis::<3>::new(6).len(), 84);
         assert_eq!(Basis::<3>::len_for(2), 10);
-        assert_eq!(Basis::<3>::new(1).exponents(), &[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]);
+        assert_eq!(
+            Basis::<3>::new(1).exponents(),
+            &[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
+        );
     }
 
     fn sample_poly3() -> Poly<3> {
@@ -345,7 +355,11 @@ mod tests {
             let mut dp = Vector3::zeros();
             dp[k] = eps;
             let fd = (f.value(&(p + dp)) - f.value(&(p - dp))) / (2.0 * eps);
-            assert!((g[k] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "grad {k}: {} vs {fd}", g[k]);
+            assert!(
+                (g[k] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                "grad {k}: {} vs {fd}",
+                g[k]
+            );
             let gp = f.value_gradient(&(p + dp)).1;
             let gm = f.value_gradient(&(p - dp)).1;
             for l in 0..3 {
@@ -362,7 +376,10 @@ mod tests {
         let p = Vector2::new(2.0, -1.0);
         assert_eq!(f.value(&p), 1.0 + 4.0 - 3.0 + 16.0 - 10.0 + 6.0);
         let (_, g, h) = f.value_gradient_hessian(&p);
-        assert_eq!(g, Vector2::new(2.0 + 8.0 * 2.0 + 5.0 * -1.0, 3.0 + 5.0 * 2.0 + 12.0 * -1.0));
+        assert_eq!(
+            g,
+            Vector2::new(2.0 + 8.0 * 2.0 + 5.0 * -1.0, 3.0 + 5.0 * 2.0 + 12.0 * -1.0)
+        );
         assert_eq!(h, nalgebra::Matrix2::new(8.0, 5.0, 5.0, 12.0));
     }
 
@@ -380,7 +397,9 @@ mod tests {
     #[test]
     fn serde_rejects_wrong_length() {
         let json = r#"{"degree":2,"coefficients":[1,2,3]}"#;
-        let err = serde_json::from_str::<Poly<2>>(json).unwrap_err().to_string();
+        let err = serde_json::from_str::<Poly<2>>(json)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("has 6 coefficients, the file has 3"), "{err}");
     }
 }

@@ -2,10 +2,13 @@
 //! components (a spurious branch near the data shows up as an extra component), and points projected onto the zero
 //! set from those cells (seeds for the exact distance, so that Newton starts on the near side of a thin section).
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use super::implicit::Implicit;
 use super::nearest::PointIndex;
+
+/// A cell counts as sharply curved when the zero set turns by more than this (radians, roughly) across it.
+const CURVED_CELL_BEND: f64 = 0.5;
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,7 +50,9 @@ impl<const N: usize> Aabb<N> {
 
 /// The zero set of F sampled over a box.
 pub struct ZeroSetSamples<const N: usize> {
+    /// The grid's samples first, then those added where the zero set bends sharply.
     points: Vec<SVector<f64, N>>,
+    coarse: usize,
     index: PointIndex<N>,
     components: usize,
     cell_size: f64,
@@ -56,17 +61,15 @@ pub struct ZeroSetSamples<const N: usize> {
 impl<const N: usize> ZeroSetSamples<N> {
     /// Samples F over `bounds` with `cells` grid cells along the longest side (cubic cells).
     pub fn new(f: &impl Implicit<N>, bounds: &Aabb<N>, cells: usize) -> Self {
-        let extent = bounds.max - bounds.min;
-        let side = extent.max() / cells as f64;
-        let counts: [usize; N] = std::array::from_fn(|k| ((extent[k] / side).ceil() as usize).max(1));
-        Self::with_counts(f, bounds, counts)
+        Self::with_counts(f, bounds, Grid::cubic(bounds, cells).counts)
     }
 
     /// Samples F over `bounds` with `counts[k]` cells along axis k (cells may be elongated: a blade surface that
     /// varies slowly along the profile axis needs few cells along it).
     pub fn with_counts(f: &impl Implicit<N>, bounds: &Aabb<N>, counts: [usize; N]) -> Self {
         let extent = bounds.max - bounds.min;
-        let cell = SVector::<f64, N>::from_fn(|k, _| extent[k].max(f64::MIN_POSITIVE) / counts[k] as f64);
+        let cell =
+            SVector::<f64, N>::from_fn(|k, _| extent[k].max(f64::MIN_POSITIVE) / counts[k] as f64);
         let cell_size = cell.max();
         let grid = Grid {
             origin: bounds.min,
@@ -76,15 +79,20 @@ impl<const N: usize> ZeroSetSamples<N> {
         let signs = grid.corner_signs(f);
         let crossing = grid.crossing_cells(&signs);
         let components = grid.count_components(&crossing);
-        let points: Vec<_> = crossing
+        let mut points: Vec<_> = crossing
             .iter()
             .enumerate()
             .filter(|(_, &c)| c)
-            .filter_map(|(index, _)| project_to_zero_set(f, &grid.cell_center(index), 1.5 * cell.norm()))
+            .filter_map(|(index, _)| {
+                project_to_zero_set(f, &grid.cell_center(index), 1.5 * cell.norm())
+            })
             .collect();
+        let coarse = points.len();
+        points.extend(grid.refine_where_curved(f, &points));
         let index = PointIndex::new(&points);
         Self {
             points,
+            coarse,
             index,
             components,
             cell_size,
@@ -103,6 +111,14 @@ impl<const N: usize> ZeroSetSamples<N> {
 
     pub fn points(&self) -> &[SVector<f64, N>] {
         &self.points
+    }
+
+    /// The nearest sample to `p`, and whether it lies where the zero set bends sharply within a grid cell (near
+    /// a sharp edge, where the distance has several local minima close together).
+    pub fn nearest(&self, p: &SVector<f64, N>) -> Option<(SVector<f64, N>, bool)> {
+        self.index
+            .nearest(p)
+            .map(|i| (self.points[i], i >= self.coarse))
     }
 
     /// Samples by increasing distance from `p`.
@@ -143,6 +159,17 @@ struct Grid<const N: usize> {
 }
 
 impl<const N: usize> Grid<N> {
+    /// A grid of cubic cells with `cells` along the longest side of `bounds`.
+    fn cubic(bounds: &Aabb<N>, cells: usize) -> Self {
+        let extent = bounds.max - bounds.min;
+        let side = extent.max() / cells as f64;
+        Self {
+            origin: bounds.min,
+            cell: SVector::repeat(side),
+            counts: std::array::from_fn(|k| ((extent[k] / side).ceil() as usize).max(1)),
+        }
+    }
+
     fn corner_counts(&self) -> [usize; N] {
         std::array::from_fn(|k| self.counts[k] + 1)
     }
@@ -153,11 +180,77 @@ impl<const N: usize> Grid<N> {
         (0..total)
             .map(|i| {
                 let idx = unflatten(i, &counts);
-                let p = self.origin
-                    + SVector::<f64, N>::from_fn(|k, _| idx[k] as f64 * self.cell[k]);
+                let p =
+                    self.origin + SVector::<f64, N>::from_fn(|k, _| idx[k] as f64 * self.cell[k]);
                 f.value(&p) > 0.0
             })
             .collect()
+    }
+
+    /// Extra samples where the zero set bends sharply within a cell (the rounded trailing edge of a blade model
+    /// turns within microns): there one sample per cell cannot seed Newton next to the right local minimum of
+    /// the distance, so the block of cells around such a sample is sampled again on a finer grid. A sharp bend
+    /// shows as high curvature at a sample, or, when the bend is narrower than a cell and falls between samples,
+    /// as neighbouring samples whose normals differ widely.
+    fn refine_where_curved(
+        &self,
+        f: &impl Implicit<N>,
+        coarse: &[SVector<f64, N>],
+    ) -> Vec<SVector<f64, N>> {
+        let side = self.cell.max();
+        let normals: Vec<SVector<f64, N>> = coarse
+            .iter()
+            .map(|x| f.value_gradient(x).1.normalize())
+            .collect();
+        let index = PointIndex::new(coarse);
+        let neighbourhood = 2.0 * self.cell.norm();
+        let mut refined_blocks = std::collections::HashSet::new();
+        let mut extra = Vec::new();
+        for (i, x) in coarse.iter().enumerate() {
+            let (_, g, h) = f.value_gradient_hessian(x);
+            let tangent_projector =
+                SMatrix::<f64, N, N>::identity() - normals[i] * normals[i].transpose();
+            // Frobenius norm of the tangential Hessian over |grad F|: an upper bound of the largest curvature.
+            let curvature = (tangent_projector * h * tangent_projector).norm() / g.norm();
+            let turn_to_neighbour = index
+                .nearest_iter(x)
+                .skip(1)
+                .take(2 * N)
+                .take_while(|&j| (coarse[j] - x).norm() <= neighbourhood)
+                .map(|j| normals[i].dot(&normals[j]).clamp(-1.0, 1.0).acos())
+                .fold(0.0, f64::max);
+            let bend = (curvature * side).max(turn_to_neighbour);
+            if !(bend > CURVED_CELL_BEND) {
+                continue;
+            }
+            let home: [usize; N] = std::array::from_fn(|k| {
+                (((x[k] - self.origin[k]) / self.cell[k]).floor().max(0.0) as usize)
+                    .min(self.counts[k] - 1)
+            });
+            if !refined_blocks.insert(home) {
+                continue;
+            }
+            let divisions = ((bend * 8.0).ceil() as usize).clamp(2, if N == 2 { 64 } else { 8 });
+            let lo: [usize; N] = std::array::from_fn(|k| home[k].saturating_sub(1));
+            let hi: [usize; N] = std::array::from_fn(|k| (home[k] + 2).min(self.counts[k]));
+            let fine = Grid {
+                origin: self.origin
+                    + SVector::<f64, N>::from_fn(|k, _| lo[k] as f64 * self.cell[k]),
+                cell: self.cell / divisions as f64,
+                counts: std::array::from_fn(|k| (hi[k] - lo[k]) * divisions),
+            };
+            let crossing = fine.crossing_cells(&fine.corner_signs(f));
+            extra.extend(
+                crossing
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, &c)| c)
+                    .filter_map(|(i, _)| {
+                        project_to_zero_set(f, &fine.cell_center(i), 1.5 * fine.cell.norm())
+                    }),
+            );
+        }
+        extra
     }
 
     fn cell_count(&self) -> usize {
@@ -266,9 +359,15 @@ mod tests {
             }
             fn value_gradient_hessian(
                 &self,
-                _: &Vector2<f64>,
+                p: &Vector2<f64>,
             ) -> (f64, Vector2<f64>, nalgebra::Matrix2<f64>) {
-                unreachable!("sampling needs no Hessian")
+                let (va, ga, ha) = self.0.value_gradient_hessian(p);
+                let (vb, gb, hb) = self.1.value_gradient_hessian(p);
+                (
+                    va * vb,
+                    ga * vb + gb * va,
+                    ha * vb + hb * va + ga * gb.transpose() + gb * ga.transpose(),
+                )
             }
         }
         let f = Product(a, b);
@@ -283,7 +382,10 @@ mod tests {
             let r = p.norm().min((p - Vector2::new(3.0, 0.0)).norm());
             assert!((r - 1.0).abs() < 1e-9, "sample {p} is off both circles");
         }
-        let near = samples.nearest_iter(&Vector2::new(3.0, 1.5)).next().unwrap();
+        let near = samples
+            .nearest_iter(&Vector2::new(3.0, 1.5))
+            .next()
+            .unwrap();
         assert!((near - Vector2::new(3.0, 1.0)).norm() < 0.06);
     }
 }

@@ -71,7 +71,11 @@ mod tests {
         let x = Vector3::new(1.0, -2.0, 0.5);
         let solved = solve(&a, &(a * x)).unwrap();
         assert!((solved - x).norm() < 1e-12);
-        assert!(solve(&Matrix3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 1.0, 1.0), &x).is_none());
+        assert!(solve(
+            &Matrix3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 1.0, 1.0),
+            &x
+        )
+        .is_none());
     }
 
     #[test]

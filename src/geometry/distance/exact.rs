@@ -10,8 +10,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{DistanceError, Foot};
 use crate::geometry::implicit::Implicit;
-use crate::geometry::small;
 use crate::geometry::sampling::{project_to_zero_set, ZeroSetSamples};
+use crate::geometry::small;
 
 /// How many sampled seeds are tried before the slow, robust fallback.
 const SEEDS_TRIED: usize = 8;
@@ -38,22 +38,71 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         p: &SVector<f64, N>,
         previous: Option<(&SVector<f64, N>, &Foot<N>)>,
     ) -> Result<Foot<N>, DistanceError> {
+        let (nearest_sample, near_sharp_edge) = self
+            .samples
+            .nearest(p)
+            .ok_or(DistanceError::NoZeroSetNearby)?;
+        // The point's own projection along the gradient: a point of the zero set that finds detail finer than the
+        // sampling grid (a spurious sliver hugging a sharp edge), which no grid sample can.
+        let own = project_to_zero_set(self.f, p, f64::INFINITY);
+        let bound = own
+            .map_or(f64::INFINITY, |x| (p - x).norm())
+            .min((p - nearest_sample).norm());
+        let mut best: Option<Foot<N>> = None;
         if let Some((prev_point, prev_foot)) = previous {
             let start = prev_foot.point + (p - prev_point);
-            if let Some(foot) = self.checked_newton(p, &start, &prev_foot.point) {
-                return Ok(foot);
+            // Cheap proofs that a foot is wrong however well it converged: the distance function is 1-Lipschitz,
+            // so it cannot jump by more than the points moved; and no foot can be farther than a known point of
+            // the zero set (a chain of feet can otherwise creep onto a branch running beside the surface).
+            let step = (p - prev_point).norm();
+            let plausible = |f: &Foot<N>| {
+                (f.distance.abs() - prev_foot.distance.abs()).abs() <= step * (1.0 + 1e-9) + 1e-12
+                    && f.distance.abs() <= bound * (1.0 + 1e-9) + 1e-12
+            };
+            best = self
+                .checked_newton(p, &start, &prev_foot.point)
+                .filter(plausible);
+            // Near a sharp edge the nearest face changes across the medial axis while the chain still follows
+            // the old one; the same happens between the walls of a sliver finer than the grid, where the point's
+            // own projection lands on the other wall. There the seeded search below runs too and the nearer
+            // foot wins.
+            if let Some(foot) = best {
+                let own_elsewhere =
+                    own.is_some_and(|x| (x - foot.point).norm() > 0.5 * foot.distance.abs() + 1e-6);
+                if !near_sharp_edge && !own_elsewhere {
+                    return Ok(foot);
+                }
+            }
+        }
+        // Near a sharp edge Newton from the nearest sample can stop at a local minimum of the distance; the global
+        // one has a sample within about a cell of it, so every seed up to that far beyond the best foot is tried.
+        let reach = 2.0 * self.samples.cell_size();
+        if let Some(foot) = own.and_then(|x| self.checked_newton(p, &x, &x)) {
+            if best.is_none_or(|b| foot.distance.abs() < b.distance.abs()) {
+                best = Some(foot);
             }
         }
         for seed in self.samples.nearest_iter(p).take(SEEDS_TRIED) {
+            if best.is_some_and(|b| (p - seed).norm() > b.distance.abs() + reach) {
+                break;
+            }
             if let Some(foot) = self.checked_newton(p, &seed, &seed) {
-                return Ok(foot);
+                if best.is_none_or(|b| foot.distance.abs() < b.distance.abs()) {
+                    best = Some(foot);
+                }
             }
         }
-        self.robust_fallback(p)
+        match best {
+            Some(foot) => Ok(foot),
+            None => self.robust_fallback(p, &nearest_sample),
+        }
     }
 
     /// Feet of a sequence of points, each seeded from the previous one (the points of one scan, in order).
-    pub fn feet_along_scan(&self, points: &[SVector<f64, N>]) -> Vec<Result<Foot<N>, DistanceError>> {
+    pub fn feet_along_scan(
+        &self,
+        points: &[SVector<f64, N>],
+    ) -> Vec<Result<Foot<N>, DistanceError>> {
         let mut out: Vec<Result<Foot<N>, DistanceError>> = Vec::with_capacity(points.len());
         for (i, p) in points.iter().enumerate() {
             let previous = match (i.checked_sub(1), out.last()) {
@@ -82,12 +131,12 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
 
     /// Slow but sure: from the nearest sample, alternate a step along the tangent towards p with a projection back
     /// onto the zero set until the foot stops moving, then polish with Newton.
-    fn robust_fallback(&self, p: &SVector<f64, N>) -> Result<Foot<N>, DistanceError> {
-        let seed = self
-            .samples
-            .nearest_iter(p)
-            .next()
-            .ok_or(DistanceError::NoZeroSetNearby)?;
+    fn robust_fallback(
+        &self,
+        p: &SVector<f64, N>,
+        nearest_sample: &SVector<f64, N>,
+    ) -> Result<Foot<N>, DistanceError> {
+        let seed = *nearest_sample;
         let travel = 4.0 * (p - seed).norm() + self.samples.cell_size();
         let mut x = seed;
         for _ in 0..500 {
@@ -95,8 +144,8 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
             let n = g.normalize();
             let offset = p - x;
             let tangential = offset - n * offset.dot(&n);
-            let next =
-                project_to_zero_set(self.f, &(x + tangential), travel).ok_or(DistanceError::NoFootPoint)?;
+            let next = project_to_zero_set(self.f, &(x + tangential), travel)
+                .ok_or(DistanceError::NoFootPoint)?;
             let moved = (next - x).norm();
             x = next;
             if moved < STEP_TOLERANCE_MM {
@@ -104,7 +153,6 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
             }
         }
         self.checked_newton(p, &x, &seed)
-            .or_else(|| signed_foot(self.f, p, x))
             .ok_or(DistanceError::NoFootPoint)
     }
 }

@@ -29,14 +29,25 @@ fn ellipse_distance(a: f64, b: f64, p: Vector2<f64>) -> f64 {
             let g = z0 * z0 + z1 * z1 - 1.0;
             if g != 0.0 {
                 let r0 = (a / b) * (a / b);
-                let (mut lo, mut hi) = (-1.0 + z1, if g < 0.0 { 0.0 } else { (r0 * z0).hypot(z1) - 1.0 });
+                let (mut lo, mut hi) = (
+                    -1.0 + z1,
+                    if g < 0.0 {
+                        0.0
+                    } else {
+                        (r0 * z0).hypot(z1) - 1.0
+                    },
+                );
                 let mut s = 0.0;
                 for _ in 0..200 {
                     s = 0.5 * (lo + hi);
                     let ratio0 = r0 * z0 / (s + r0);
                     let ratio1 = z1 / (s + 1.0);
                     let gs = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
-                    if gs > 0.0 { lo = s } else { hi = s }
+                    if gs > 0.0 {
+                        lo = s
+                    } else {
+                        hi = s
+                    }
                 }
                 let x0 = r0 * y0 / (s + r0);
                 let x1 = y1 / (s + 1.0);
@@ -58,7 +69,10 @@ fn ellipse_distance(a: f64, b: f64, p: Vector2<f64>) -> f64 {
 }
 
 fn samples_for(model: &IpModel<2>, half: f64) -> ZeroSetSamples<2> {
-    let bounds = Aabb { min: Vector2::new(-half, -half), max: Vector2::new(half, half) };
+    let bounds = Aabb {
+        min: Vector2::new(-half, -half),
+        max: Vector2::new(half, half),
+    };
     ZeroSetSamples::new(model, &bounds, 512)
 }
 
@@ -86,7 +100,11 @@ fn exact_distance_to_a_circle_is_the_radial_offset() {
     let exact = ExactDistance::new(&model, &samples);
     for p in polar_points(&[3.0, 20.0, 24.9, 25.3, 40.0], 37) {
         let d = exact.foot(&p, None).unwrap().distance;
-        assert!((d - (p.norm() - r)).abs() < 1e-9, "at {p}: {d} vs {}", p.norm() - r);
+        assert!(
+            (d - (p.norm() - r)).abs() < 1e-9,
+            "at {p}: {d} vs {}",
+            p.norm() - r
+        );
     }
 }
 
@@ -157,16 +175,26 @@ fn paper_approximation_is_second_order_accurate_on_an_ellipse() {
                     // The construction is second-order accurate: its error grows as d^2 / R (about 4 um at 1 mm
                     // from a 200 mm curvature radius, below 1 um at 0.5 mm, as the paper reports for blades).
                     let bound = reference * reference / radius + 1e-6;
-                    assert!((foot.distance - reference).abs() < bound, "at {p}: {} vs {reference}", foot.distance);
+                    assert!(
+                        (foot.distance - reference).abs() < bound,
+                        "at {p}: {} vs {reference}",
+                        foot.distance
+                    );
                 }
             }
             Err(why) => {
-                assert!(radius < 5.0, "the paper's method failed on a gentle stretch at {p} (radius {radius}): {why}");
+                assert!(
+                    radius < 5.0,
+                    "the paper's method failed on a gentle stretch at {p} (radius {radius}): {why}"
+                );
                 failed_at_ends += 1;
             }
         }
     }
-    assert!(answered + failed_at_ends == 2000 && answered > 1900, "answered {answered}");
+    assert!(
+        answered + failed_at_ends == 2000 && answered > 1900,
+        "answered {answered}"
+    );
 }
 
 #[test]

@@ -1,0 +1,225 @@
+//! Fitting tests against published and analytic ground truth.
+
+use nalgebra::Vector2;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+use super::*;
+use crate::geometry::implicit::{Frame, Implicit};
+use crate::geometry::normals::ordered_profile_normals;
+use crate::geometry::trace::{resample_closed, trace_closed_curve};
+
+/// The quartic that seed 003 publishes for profile 3 of blade A (coefficients in cm), re-expressed in mm.
+pub(crate) fn published_profile_3() -> IpModel<2> {
+    // Terms as printed, in the order y^4, y^3 z, ..., constant, with their (y, z) exponents.
+    let terms: [((u8, u8), f64); 15] = [
+        ((4, 0), 1.0),
+        ((3, 1), -1.038),
+        ((2, 2), 3.041),
+        ((1, 3), -3.765),
+        ((0, 4), 1.922),
+        ((3, 0), 15.833),
+        ((2, 1), -31.942),
+        ((1, 2), 29.537),
+        ((0, 3), -25.706),
+        ((2, 0), -102.36),
+        ((1, 1), 29.709),
+        ((0, 2), -187.493),
+        ((1, 0), -1522.1),
+        ((0, 1), 1811.3),
+        ((0, 0), 9445.3),
+    ];
+    let mut poly = Poly::<2>::zero(4);
+    for ((i, j), c) in terms {
+        let index = poly.basis().index_of(&[i, j]).unwrap();
+        // F_mm(p) = F_cm(p / 10): a degree-k term scales by 10^-k.
+        poly.coeffs_mut()[index] = c * 10f64.powi(-((i + j) as i32));
+    }
+    IpModel {
+        frame: Frame::identity(),
+        poly,
+    }
+}
+
+/// Largest and RMS exact distance from `truth` points to the fitted model, and where the largest is.
+pub(crate) fn deviation_from(
+    fitted: &Fitted<2>,
+    truth: &[Vector2<f64>],
+) -> (f64, f64, Vector2<f64>) {
+    let samples = ZeroSetSamples::new(&fitted.model, &fitted.domain.scaled(2.0), 1024);
+    let exact = ExactDistance::new(&fitted.model, &samples);
+    let mut worst = (0.0f64, truth[0]);
+    let mut sum = 0.0;
+    for (p, foot) in truth.iter().zip(exact.feet_along_scan(truth)) {
+        let d = foot.expect("every truth point has a foot").distance.abs();
+        sum += d * d;
+        if d > worst.0 {
+            worst = (d, *p);
+        }
+    }
+    (worst.0, (sum / truth.len() as f64).sqrt(), worst.1)
+}
+
+/// Ordered points moved along the true normal by seeded Gaussian noise of `sigma` mm.
+pub(crate) fn noisy(
+    model: &impl Implicit<2>,
+    points: &[Vector2<f64>],
+    sigma: f64,
+    seed: u64,
+) -> Vec<Vector2<f64>> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let normal = Normal::new(0.0, sigma).unwrap();
+    points
+        .iter()
+        .map(|p| p + model.value_gradient(p).1.normalize() * normal.sample(&mut rng))
+        .collect()
+}
+
+fn profile_3_truth() -> Vec<Vector2<f64>> {
+    let model = published_profile_3();
+    let start = project_to_zero_set(&model, &Vector2::new(100.0, 320.0), 50.0).unwrap();
+    trace_closed_curve(&model, &start, 0.05, 1_000_000).unwrap()
+}
+
+fn fit_profile(points: &[Vector2<f64>], degree: usize, method: FitMethod) -> Fitted<2> {
+    let normals = ordered_profile_normals(points);
+    fit_ip(points, &normals, &FitOptions::new(degree, method)).unwrap()
+}
+
+#[test]
+fn published_profile_3_refitted_from_noisy_points_lies_within_5_um() {
+    let truth = profile_3_truth();
+    let model = published_profile_3();
+    let measured = noisy(&model, &resample_closed(&truth, 400), 0.002, 3);
+    let odr = fit_profile(&measured, 4, FitMethod::Orthogonal);
+    let (max, rms, at) = deviation_from(&odr, &truth);
+    eprintln!(
+        "profile 3, odr: max {max:.6} mm at {at:?}, rms {rms:.6} mm, stats {:?}",
+        odr.stats
+    );
+    assert!(max < 0.005, "max {max} mm at {at}");
+    let plain = fit_profile(&measured, 4, FitMethod::ThreeL);
+    let (plain_max, plain_rms, _) = deviation_from(&plain, &truth);
+    eprintln!(
+        "profile 3, plain 3L: max {plain_max:.6} rms {plain_rms:.6} stats {:?}",
+        plain.stats
+    );
+    let ridge = fit_profile(&measured, 4, FitMethod::Ridge);
+    let (ridge_max, ridge_rms, _) = deviation_from(&ridge, &truth);
+    eprintln!("profile 3, ridge: max {ridge_max:.6} rms {ridge_rms:.6}");
+    assert!(
+        plain_max > 2.0 * max,
+        "the refinement must beat plain 3L: {plain_max} vs {max}"
+    );
+}
+
+/// A NACA 2412 section of 100 mm chord with a sharp trailing edge: `dense` points of the true section, and a
+/// scan of `count` points with 2 um of seeded Gaussian noise along the normal.
+pub(crate) fn naca_2412_truth_and_scan(
+    dense: usize,
+    count: usize,
+) -> (Vec<Vector2<f64>>, Vec<Vector2<f64>>) {
+    let foil = zeroset_sim::naca::Naca4::from_digits("2412", 100.0, true).unwrap();
+    let to_vector = |p: &[f64; 2]| Vector2::new(p[0], p[1]);
+    let truth: Vec<Vector2<f64>> = foil.points(dense).iter().map(to_vector).collect();
+    let clean: Vec<Vector2<f64>> = foil.points(count).iter().map(to_vector).collect();
+    let truth_normals = ordered_profile_normals(&clean);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2412);
+    let noise = Normal::new(0.0, 0.002).unwrap();
+    let measured = clean
+        .iter()
+        .zip(&truth_normals)
+        .map(|(p, n)| p + n * noise.sample(&mut rng))
+        .collect();
+    (truth, measured)
+}
+
+#[test]
+fn naca_2412_section_at_degrees_4_to_10() {
+    let (truth, measured) = naca_2412_truth_and_scan(20_000, 400);
+    for degree in [4, 6, 8, 10] {
+        for method in [FitMethod::ThreeL, FitMethod::Ridge, FitMethod::Orthogonal] {
+            let normals = ordered_profile_normals(&measured);
+            let options = FitOptions::new(degree, method);
+            let fitted = fit_ip(&measured, &normals, &options).unwrap();
+            let (max, rms, at) = deviation_from(&fitted, &truth);
+            let inner: Vec<_> = truth
+                .iter()
+                .copied()
+                .filter(|p| p.x > 5.0 && p.x < 95.0)
+                .collect();
+            let (inner_max, _, inner_at) = deviation_from(&fitted, &inner);
+            eprintln!("naca degree {degree} {method:?}: max {max:.4} at ({:.2},{:.3}) rms {rms:.4}; inner max {inner_max:.4} at ({:.1},{:.2}); comps {} cond {:.1e} iters {}", at.x, at.y, inner_at.x, inner_at.y, fitted.stats.zero_set_components, fitted.stats.condition_number, fitted.stats.refinement_iterations);
+        }
+    }
+}
+
+/// Checks that no part of the zero set enters the disk of radius `distance` around `p` (F keeps the sign of
+/// F(p) on a fine polar grid inside it): `distance` is then the global minimum, up to the grid's resolution.
+pub(crate) fn assert_global_minimum(model: &impl Implicit<2>, p: &Vector2<f64>, distance: f64) {
+    let side = model.value(p).signum();
+    for ring in 1..200 {
+        let r = distance * (ring as f64 / 200.0) * (1.0 - 1e-6);
+        for k in 0..400 {
+            let t = k as f64 / 400.0 * std::f64::consts::TAU;
+            let q = p + Vector2::new(t.cos(), t.sin()) * r;
+            assert!(
+                model.value(&q) * side > 0.0,
+                "the zero set is {r} mm from {p}, nearer than the foot at {distance} mm"
+            );
+        }
+    }
+}
+
+#[test]
+fn exact_distances_along_a_dense_scan_are_global_minima_edges_included() {
+    // A clean model (one zero-set component): every foot along a dense scan of the true section, trailing and
+    // leading edges included, is the global minimum, and equals the foot found from scratch.
+    let (truth, measured) = naca_2412_truth_and_scan(20_000, 400);
+    let fitted = fit_profile(&measured, 6, FitMethod::Orthogonal);
+    assert_eq!(fitted.stats.zero_set_components, 1);
+    let samples = ZeroSetSamples::new(&fitted.model, &fitted.domain.scaled(2.0), 512);
+    let exact = ExactDistance::new(&fitted.model, &samples);
+    let chained = exact.feet_along_scan(&truth);
+    let edges = |p: &Vector2<f64>| p.x < 1.0 || p.x > 99.0;
+    for (i, (p, foot)) in truth.iter().zip(&chained).enumerate() {
+        if i % 13 != 0 && !edges(p) {
+            continue;
+        }
+        let chained = foot.unwrap().distance;
+        let alone = exact.foot(p, None).unwrap().distance;
+        assert!(
+            (chained - alone).abs() < 1e-6,
+            "at {p}: chained {chained} alone {alone}"
+        );
+        if i % 5 == 0 {
+            assert_global_minimum(&fitted.model, p, chained.abs());
+        }
+    }
+}
+
+#[test]
+fn a_chain_of_feet_does_not_creep_onto_a_spurious_branch() {
+    // This degree-10 fit has spurious branches a tenth of a millimetre from the trailing edge, some finer than
+    // the sampling grid. A chain of feet seeded each from the previous one crept onto one of them (0.1 mm off)
+    // until feet were bounded by the sampled zero set and checked against the point's own projection.
+    let (truth, measured) = naca_2412_truth_and_scan(20_000, 400);
+    let normals = ordered_profile_normals(&measured);
+    let mut options = FitOptions::new(10, FitMethod::Orthogonal);
+    options.offset = Some(0.03);
+    let fitted = fit_ip(&measured, &normals, &options).unwrap();
+    assert!(
+        fitted.stats.zero_set_components > 1,
+        "the case needs its spurious branches"
+    );
+    let samples = ZeroSetSamples::new(&fitted.model, &fitted.domain.scaled(2.0), 1024);
+    let exact = ExactDistance::new(&fitted.model, &samples);
+    for (p, chained) in truth.iter().zip(exact.feet_along_scan(&truth)).step_by(3) {
+        let alone = exact.foot(p, None).unwrap().distance;
+        let chained = chained.unwrap().distance;
+        assert!(
+            chained.abs() <= alone.abs() + 1e-6,
+            "at {p}: chained {chained} alone {alone}"
+        );
+    }
+}

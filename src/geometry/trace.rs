@@ -1,0 +1,100 @@
+//! Tracing a closed planar zero-set curve: predictor (a step along the tangent) and corrector (Newton's projection
+//! back onto the curve), until the curve closes. Used to compare a fitted curve with a reference one everywhere,
+//! and to draw models.
+
+use nalgebra::Vector2;
+
+use super::implicit::Implicit;
+use super::sampling::project_to_zero_set;
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TraceError {
+    #[error("the start point could not be projected onto the curve")]
+    StartOffCurve,
+    #[error(
+        "the curve could not be followed (singular point or a step that jumped to another branch)"
+    )]
+    Lost,
+    #[error("the curve did not close within {0} steps")]
+    NotClosed(usize),
+}
+
+/// Points along the closed curve through (the projection of) `start`, about `step` mm apart, in the direction
+/// that keeps the outside (F > 0) on the right: counter-clockwise around the material.
+pub fn trace_closed_curve(
+    f: &impl Implicit<2>,
+    start: &Vector2<f64>,
+    step: f64,
+    max_steps: usize,
+) -> Result<Vec<Vector2<f64>>, TraceError> {
+    let first = project_to_zero_set(f, start, 10.0 * step).ok_or(TraceError::StartOffCurve)?;
+    let mut points = vec![first];
+    let mut current = first;
+    for _ in 0..max_steps {
+        let (_, g) = f.value_gradient(&current);
+        let tangent = Vector2::new(-g.y, g.x).normalize();
+        let next =
+            project_to_zero_set(f, &(current + tangent * step), step).ok_or(TraceError::Lost)?;
+        if (next - current).norm() < 0.25 * step {
+            return Err(TraceError::Lost);
+        }
+        if points.len() > 3 && (next - first).norm() < 0.75 * step {
+            return Ok(points);
+        }
+        points.push(next);
+        current = next;
+    }
+    Err(TraceError::NotClosed(max_steps))
+}
+
+/// `count` points evenly spaced by arc length along a closed polyline (the curve's own points stay the corners).
+pub fn resample_closed(points: &[Vector2<f64>], count: usize) -> Vec<Vector2<f64>> {
+    let n = points.len();
+    let lengths: Vec<f64> = (0..n)
+        .map(|i| (points[(i + 1) % n] - points[i]).norm())
+        .collect();
+    let total: f64 = lengths.iter().sum();
+    let mut out = Vec::with_capacity(count);
+    let mut segment = 0;
+    let mut start_of_segment = 0.0;
+    for k in 0..count {
+        let target = total * k as f64 / count as f64;
+        while start_of_segment + lengths[segment] < target && segment + 1 < n {
+            start_of_segment += lengths[segment];
+            segment += 1;
+        }
+        let t = ((target - start_of_segment) / lengths[segment]).clamp(0.0, 1.0);
+        out.push(points[segment] + (points[(segment + 1) % n] - points[segment]) * t);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::poly::Poly;
+
+    #[test]
+    fn traces_a_circle_counter_clockwise() {
+        // (x^2 + y^2 - 100) / 20: a circle of radius 10 mm, F > 0 outside.
+        let circle = Poly::<2>::new(2, vec![-5.0, 0.0, 0.0, 0.05, 0.0, 0.05]);
+        let points = trace_closed_curve(&circle, &Vector2::new(10.5, 0.0), 0.1, 10_000).unwrap();
+        let expected = (std::f64::consts::TAU * 10.0 / 0.1).round() as usize;
+        assert!(
+            points.len().abs_diff(expected) <= 2,
+            "{} points",
+            points.len()
+        );
+        assert!(points.iter().all(|p| (p.norm() - 10.0).abs() < 1e-9));
+        // Counter-clockwise: the second point is above the first on the right-hand side of the circle.
+        assert!(points[1].y > points[0].y);
+        let even = resample_closed(&points, 100);
+        let gaps: Vec<f64> = (0..100)
+            .map(|i| (even[(i + 1) % 100] - even[i]).norm())
+            .collect();
+        let (lo, hi) = gaps
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(a, b), g| (a.min(*g), b.max(*g)));
+        assert!(hi - lo < 1e-3, "gaps from {lo} to {hi}");
+    }
+}
