@@ -18,7 +18,10 @@ pub struct Naca4 {
 impl Naca4 {
     /// Parses the four digits, e.g. "2412".
     pub fn from_digits(digits: &str, chord_mm: f64, sharp_trailing_edge: bool) -> Option<Self> {
-        let d: Vec<u32> = digits.chars().map(|c| c.to_digit(10)).collect::<Option<_>>()?;
+        let d: Vec<u32> = digits
+            .chars()
+            .map(|c| c.to_digit(10))
+            .collect::<Option<_>>()?;
         if d.len() != 4 {
             return None;
         }
@@ -33,9 +36,15 @@ impl Naca4 {
 
     /// Half thickness at chord fraction x in [0, 1] (as a fraction of chord).
     fn half_thickness(&self, x: f64) -> f64 {
-        let a4 = if self.sharp_trailing_edge { -0.1036 } else { -0.1015 };
+        let a4 = if self.sharp_trailing_edge {
+            -0.1036
+        } else {
+            -0.1015
+        };
         5.0 * self.thickness
-            * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3) + a4 * x.powi(4))
+            * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x
+                + 0.2843 * x.powi(3)
+                + a4 * x.powi(4))
     }
 
     /// Mean camber line height and slope at chord fraction x.
@@ -45,10 +54,16 @@ impl Naca4 {
             return (0.0, 0.0);
         }
         if x < p {
-            (m / (p * p) * (2.0 * p * x - x * x), 2.0 * m / (p * p) * (p - x))
+            (
+                m / (p * p) * (2.0 * p * x - x * x),
+                2.0 * m / (p * p) * (p - x),
+            )
         } else {
             let q = (1.0 - p) * (1.0 - p);
-            (m / q * (1.0 - 2.0 * p + 2.0 * p * x - x * x), 2.0 * m / q * (p - x))
+            (
+                m / q * (1.0 - 2.0 * p + 2.0 * p * x - x * x),
+                2.0 * m / q * (p - x),
+            )
         }
     }
 
@@ -70,7 +85,9 @@ impl Naca4 {
 
     /// `count` points evenly spaced in the parameter, in order around the section.
     pub fn points(&self, count: usize) -> Vec<[f64; 2]> {
-        (0..count).map(|i| self.point(i as f64 / count as f64)).collect()
+        (0..count)
+            .map(|i| self.point(i as f64 / count as f64))
+            .collect()
     }
 }
 
@@ -82,14 +99,19 @@ mod tests {
     fn naca_2412_has_its_published_thickness_and_camber() {
         let foil = Naca4::from_digits("2412", 100.0, true).unwrap();
         // Maximum thickness of a 12% section is 12 mm on a 100 mm chord, near 30% chord.
-        let t = (1..1000).map(|i| 2.0 * foil.half_thickness(i as f64 / 1000.0)).fold(0.0, f64::max);
+        let t = (1..1000)
+            .map(|i| 2.0 * foil.half_thickness(i as f64 / 1000.0))
+            .fold(0.0, f64::max);
         assert!((t - 0.12).abs() < 2e-4, "max thickness {t}");
         assert!((foil.camber(0.4).0 - 0.02).abs() < 1e-12);
         // A sharp trailing edge closes: both surfaces meet at (100, 0).
         let te = foil.point(0.0);
         assert!(te[0] > 99.99 && te[1].abs() < 1e-3, "trailing edge {te:?}");
         let le = foil.point(0.5);
-        assert!(le[0].abs() < 1e-9 && le[1].abs() < 1e-9, "leading edge {le:?}");
+        assert!(
+            le[0].abs() < 1e-9 && le[1].abs() < 1e-9,
+            "leading edge {le:?}"
+        );
         assert!(Naca4::from_digits("24x2", 1.0, true).is_none());
     }
 }

@@ -8,6 +8,7 @@ pub mod interp;
 pub mod nearest;
 pub mod normals;
 pub mod poly;
+pub mod published;
 pub mod sampling;
 pub mod small;
 pub mod trace;

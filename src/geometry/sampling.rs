@@ -11,9 +11,11 @@ use super::nearest::PointIndex;
 const CURVED_CELL_BEND: f64 = 0.5;
 
 /// An axis-aligned box.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Aabb<const N: usize> {
+    #[serde(with = "super::implicit::vector_as_array")]
     pub min: SVector<f64, N>,
+    #[serde(with = "super::implicit::vector_as_array")]
     pub max: SVector<f64, N>,
 }
 
@@ -88,7 +90,11 @@ impl<const N: usize> ZeroSetSamples<N> {
             })
             .collect();
         let coarse = points.len();
-        points.extend(grid.refine_where_curved(f, &points));
+        // Surfaces are not refined: a 3-D block at the resolution that helps is thousands of evaluations of a
+        // polynomial with hundreds of terms per sample, which made a stack's distances take a minute.
+        if N == 2 {
+            points.extend(grid.refine_where_curved(f, &points));
+        }
         let index = PointIndex::new(&points);
         Self {
             points,

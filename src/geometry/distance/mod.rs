@@ -8,6 +8,7 @@
 
 mod exact;
 mod paper;
+mod stack;
 
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -15,8 +16,10 @@ use serde::{Deserialize, Serialize};
 pub use exact::ExactDistance;
 pub(crate) use exact::{crosses_zero_set, lagrange_newton};
 pub use paper::paper_distance;
+pub use stack::StackDistance;
 
 use super::implicit::Implicit;
+use super::sampling::ZeroSetSamples;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -41,6 +44,18 @@ impl DistanceMethod {
 pub struct Foot<const N: usize> {
     pub point: SVector<f64, N>,
     pub distance: f64,
+}
+
+impl DistanceError {
+    /// A short machine-readable label for CSV files.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Paper(failure) => failure.label(),
+            Self::ZeroGradient => "zero-gradient",
+            Self::NoZeroSetNearby => "no-zero-set-nearby",
+            Self::NoFootPoint => "no-foot-point",
+        }
+    }
 }
 
 /// Why the paper's approximation gave no distance for a point.
@@ -81,6 +96,33 @@ pub enum DistanceError {
     NoZeroSetNearby,
     #[error("no foot point found on the model")]
     NoFootPoint,
+}
+
+/// Signed distances (mm) of points, in order (the points of a scan seed each other), by `method`. `reach` bounds
+/// how far the paper's projections may travel (a few model sizes).
+pub fn signed_distances<F: Implicit<N>, const N: usize>(
+    f: &F,
+    samples: &ZeroSetSamples<N>,
+    points: &[SVector<f64, N>],
+    method: DistanceMethod,
+    reach: f64,
+) -> Vec<Result<f64, DistanceError>> {
+    match method {
+        DistanceMethod::Exact => ExactDistance::new(f, samples)
+            .feet_along_scan(points)
+            .into_iter()
+            .map(|foot| foot.map(|f| f.distance))
+            .collect(),
+        DistanceMethod::Paper => points
+            .iter()
+            .map(|p| {
+                paper_distance(f, p, reach)
+                    .map(|foot| foot.distance)
+                    .map_err(DistanceError::from)
+            })
+            .collect(),
+        DistanceMethod::Taubin => points.iter().map(|p| taubin_distance(f, p)).collect(),
+    }
 }
 
 /// Taubin's signed estimate F / |grad F|.

@@ -5,40 +5,12 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
 use super::*;
-use crate::geometry::implicit::{Frame, Implicit};
+use crate::geometry::implicit::Implicit;
 use crate::geometry::normals::ordered_profile_normals;
 use crate::geometry::trace::{resample_closed, trace_closed_curve};
 
-/// The quartic that seed 003 publishes for profile 3 of blade A (coefficients in cm), re-expressed in mm.
 pub(crate) fn published_profile_3() -> IpModel<2> {
-    // Terms as printed, in the order y^4, y^3 z, ..., constant, with their (y, z) exponents.
-    let terms: [((u8, u8), f64); 15] = [
-        ((4, 0), 1.0),
-        ((3, 1), -1.038),
-        ((2, 2), 3.041),
-        ((1, 3), -3.765),
-        ((0, 4), 1.922),
-        ((3, 0), 15.833),
-        ((2, 1), -31.942),
-        ((1, 2), 29.537),
-        ((0, 3), -25.706),
-        ((2, 0), -102.36),
-        ((1, 1), 29.709),
-        ((0, 2), -187.493),
-        ((1, 0), -1522.1),
-        ((0, 1), 1811.3),
-        ((0, 0), 9445.3),
-    ];
-    let mut poly = Poly::<2>::zero(4);
-    for ((i, j), c) in terms {
-        let index = poly.basis().index_of(&[i, j]).unwrap();
-        // F_mm(p) = F_cm(p / 10): a degree-k term scales by 10^-k.
-        poly.coeffs_mut()[index] = c * 10f64.powi(-((i + j) as i32));
-    }
-    IpModel {
-        frame: Frame::identity(),
-        poly,
-    }
+    crate::geometry::published::seed_003_profile(3).unwrap()
 }
 
 /// Largest and RMS exact distance from `truth` points to the fitted model, and where the largest is.

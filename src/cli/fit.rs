@@ -1,0 +1,254 @@
+//! `zeroset fit ip`: fit an implicit polynomial to a point file and save it as a model file.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context};
+use clap::{Args, ValueEnum};
+use nalgebra::{SVector, Vector2, Vector3};
+
+use super::{all_rows, MethodArg};
+use crate::geometry::fit3l::{fit_ip, FitOptions, Fitted};
+use crate::geometry::nearest::PointIndex;
+use crate::geometry::normals::{ordered_profile_normals, pca_normals};
+use crate::model_file::{FittedIp, ModelFile, ReferenceModel, StackProfile};
+use crate::points::{read_points, PointSet};
+
+#[derive(Args)]
+pub struct FitIpArgs {
+    /// Point file: CSV with header y,z (a profile) or x,y,z (3-D), in mm.
+    #[arg(long)]
+    points: PathBuf,
+    /// Degree of the polynomial (of each profile, for a stack).
+    #[arg(long, default_value_t = 4)]
+    degree: usize,
+    #[arg(long, value_enum, default_value = "odr")]
+    method: MethodArg,
+    /// Where the outward normals for the 3L offsets come from.
+    #[arg(long, value_enum, default_value = "auto")]
+    normals: NormalsArg,
+    /// Treat x,y,z points as parallel planar profiles at constant x and fit a stack of profile models blended
+    /// along x (seed 003 section 4).
+    #[arg(long)]
+    stack: bool,
+    /// Points whose x differ by less than this (mm) belong to the same profile plane (with --stack).
+    #[arg(long, default_value_t = 1.0)]
+    plane_tolerance: f64,
+    /// The model file to write (JSON).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum NormalsArg {
+    /// From the order of the points when they run along the profile, else by local PCA.
+    Auto,
+    /// From the order of the points along a closed profile.
+    Ordered,
+    /// By local principal component analysis (any order).
+    Pca,
+}
+
+pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let points = read_points(&args.points)?;
+    let options = FitOptions::new(args.degree, args.method.into());
+    let (model, method) = match (points, args.stack) {
+        (PointSet::Profile(points), false) => {
+            let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
+            print_fit(&args.points, "profile", &fitted);
+            (
+                ReferenceModel::Profile(into_file(fitted.clone())),
+                fitted.method,
+            )
+        }
+        (PointSet::Spatial(points), false) => {
+            if args.normals == NormalsArg::Ordered {
+                bail!(
+                    "{}: ordered normals need a planar profile (y,z); 3-D points use --normals pca",
+                    args.points.display()
+                );
+            }
+            let normals = pca_normals(&points);
+            let fitted = fit_ip(&points, &normals, &options)
+                .map_err(|e| anyhow!("{}: {e}", all_rows(&args.points, points.len())))?;
+            print_fit(&args.points, "surface", &fitted);
+            (
+                ReferenceModel::Surface(into_file(fitted.clone())),
+                fitted.method,
+            )
+        }
+        (PointSet::Spatial(points), true) => {
+            let profiles = fit_stack(&args.points, &points, &options, args)?;
+            (ReferenceModel::Stack { profiles }, options.method)
+        }
+        (PointSet::Profile(_), true) => {
+            bail!(
+                "{}: --stack needs x,y,z points (parallel profiles at constant x)",
+                args.points.display()
+            )
+        }
+    };
+    let file = ModelFile::new(method.describe(), model);
+    if let ReferenceModel::Stack { profiles } = &file.model {
+        crate::model_file::stack_of(profiles)
+            .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
+    }
+    file.save(&args.out)?;
+    println!(
+        "wrote {} ({:.2} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn into_file<const N: usize>(fitted: Fitted<N>) -> FittedIp<N> {
+    FittedIp {
+        ip: fitted.model,
+        domain: fitted.domain,
+        fit: Some(fitted.stats),
+    }
+}
+
+fn fit_profile(
+    path: &Path,
+    points: &[Vector2<f64>],
+    options: &FitOptions,
+    normals: NormalsArg,
+) -> anyhow::Result<Fitted<2>> {
+    if points.len() < 3 {
+        bail!(
+            "{}: {} points are too few for a profile",
+            all_rows(path, points.len()),
+            points.len()
+        );
+    }
+    let ordered = match normals {
+        NormalsArg::Ordered => true,
+        NormalsArg::Pca => false,
+        NormalsArg::Auto => runs_along_the_profile(points),
+    };
+    let normals = if ordered {
+        ordered_profile_normals(points)
+    } else {
+        pca_normals(points)
+    };
+    fit_ip(points, &normals, options).map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
+}
+
+/// Whether the points are in scan order: nearly every step to the next point is about as short as the step to
+/// the nearest point. Shuffled points jump across the part instead.
+fn runs_along_the_profile<const N: usize>(points: &[SVector<f64, N>]) -> bool {
+    let index = PointIndex::new(points);
+    let n = points.len();
+    let in_order = (0..n)
+        .filter(|&i| {
+            let next = (points[(i + 1) % n] - points[i]).norm();
+            let nearest = index
+                .nearest_iter(&points[i])
+                .nth(1)
+                .map_or(0.0, |j| (points[j] - points[i]).norm());
+            next <= 4.0 * nearest
+        })
+        .count();
+    in_order as f64 >= 0.95 * n as f64
+}
+
+fn fit_stack(
+    path: &Path,
+    points: &[Vector3<f64>],
+    options: &FitOptions,
+    args: &FitIpArgs,
+) -> anyhow::Result<Vec<StackProfile>> {
+    let planes = group_into_planes(points, args.plane_tolerance);
+    if planes.len() < 2 {
+        bail!(
+            "{}: the points lie in {} plane(s) of constant x (tolerance {} mm); a stack needs at least two",
+            all_rows(path, points.len()),
+            planes.len(),
+            args.plane_tolerance
+        );
+    }
+    let mut profiles = Vec::with_capacity(planes.len());
+    for (x, plane) in planes {
+        let yz: Vec<Vector2<f64>> = plane.iter().map(|p| Vector2::new(p.y, p.z)).collect();
+        let fitted = fit_profile(path, &yz, options, args.normals)
+            .with_context(|| format!("the profile at x = {x:.3} mm"))?;
+        print_fit(path, &format!("profile at x = {x:.3} mm"), &fitted);
+        profiles.push(StackProfile {
+            x,
+            fitted: into_file(fitted),
+        });
+    }
+    Ok(profiles)
+}
+
+/// Splits points into planes of (nearly) constant x, keeping file order within each plane.
+fn group_into_planes(points: &[Vector3<f64>], tolerance: f64) -> Vec<(f64, Vec<Vector3<f64>>)> {
+    let mut xs: Vec<f64> = points.iter().map(|p| p.x).collect();
+    xs.sort_by(f64::total_cmp);
+    let mut centres: Vec<Vec<f64>> = Vec::new();
+    for x in xs {
+        match centres.last_mut() {
+            Some(group) if x - group[group.len() - 1] <= tolerance => group.push(x),
+            _ => centres.push(vec![x]),
+        }
+    }
+    let bounds: Vec<(f64, f64)> = centres.iter().map(|g| (g[0], g[g.len() - 1])).collect();
+    bounds
+        .iter()
+        .map(|&(lo, hi)| {
+            let plane: Vec<Vector3<f64>> = points
+                .iter()
+                .copied()
+                .filter(|p| p.x >= lo && p.x <= hi)
+                .collect();
+            let x = plane.iter().map(|p| p.x).sum::<f64>() / plane.len() as f64;
+            (x, plane)
+        })
+        .collect()
+}
+
+fn print_fit<const N: usize>(path: &Path, what: &str, fitted: &Fitted<N>) {
+    let s = &fitted.stats;
+    let at: Vec<String> = s
+        .max_distance_at
+        .iter()
+        .map(|c| format!("{c:.3}"))
+        .collect();
+    println!(
+        "fitted a degree-{} implicit polynomial ({what}) to {} points of {} by {}",
+        fitted.model.degree(),
+        s.points,
+        path.display(),
+        fitted.method.describe()
+    );
+    println!(
+        "  distance of the fitted points to the model: RMS {:.4} mm, max {:.4} mm at ({}) mm",
+        s.rms_distance_mm,
+        s.max_distance_mm,
+        at.join(", ")
+    );
+    println!(
+        "  condition number {:.1e}; 3L offsets {:.3} to {:.3} mm; {} refinement iterations",
+        s.condition_number, s.offset_min_mm, s.offset_max_mm, s.refinement_iterations
+    );
+    println!(
+        "  zero set: {} component(s) within twice the data's box",
+        s.zero_set_components
+    );
+    if s.zero_set_components > 1 {
+        println!(
+            "  warning: the model has {} zero-set components near the data: a spurious branch; check deviations \
+             near it, or try another degree or method",
+            s.zero_set_components
+        );
+    }
+    if s.points_without_foot > 0 {
+        println!(
+            "  warning: {} fitted points have no foot point on the model",
+            s.points_without_foot
+        );
+    }
+}

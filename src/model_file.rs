@@ -1,0 +1,145 @@
+//! Reference-model files: versioned JSON holding the kind, the polynomial (degree and coefficients in the
+//! monomial order of seed 003, in normalised coordinates), the normalisation, the units, the fitting method and
+//! the fit statistics, so that a report can always say exactly what a deviation was measured against.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::fsutil::write_atomically;
+use crate::geometry::fit3l::FitStats;
+use crate::geometry::implicit::IpModel;
+use crate::geometry::interp::{Profile, ProfileStack, StackError};
+use crate::geometry::sampling::Aabb;
+
+pub const FORMAT: &str = "zeroset-model";
+pub const VERSION: u32 = 1;
+/// How to read the coefficient vectors, written into every file for whoever reads it without this code.
+pub const MONOMIAL_ORDER: &str =
+    "graded by total degree, then descending powers of the first variable, then of the second (seed 003)";
+
+/// A reference model file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    pub format: String,
+    pub version: u32,
+    pub units: String,
+    pub monomial_order: String,
+    /// How the model was made: a fitting method, or where a published model comes from.
+    pub method: String,
+    pub model: ReferenceModel,
+}
+
+/// The kinds of reference model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", deny_unknown_fields)]
+pub enum ReferenceModel {
+    /// One planar profile in the (y, z) plane: variables y, z.
+    #[serde(rename = "ip-profile")]
+    Profile(FittedIp<2>),
+    /// One surface: variables x, y, z.
+    #[serde(rename = "ip-surface")]
+    Surface(FittedIp<3>),
+    /// Parallel profiles along x blended linearly into a piecewise 3-D model (seed 003 section 4).
+    #[serde(rename = "ip-stack")]
+    Stack { profiles: Vec<StackProfile> },
+}
+
+/// An implicit polynomial with the box of the data it was fitted to (where it is valid) and its statistics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FittedIp<const N: usize> {
+    pub ip: IpModel<N>,
+    pub domain: Aabb<N>,
+    pub fit: Option<FitStats>,
+}
+
+/// One profile of a stack: its position along x (mm) and its fitted (y, z) model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StackProfile {
+    pub x: f64,
+    #[serde(flatten)]
+    pub fitted: FittedIp<2>,
+}
+
+impl ModelFile {
+    pub fn new(method: impl Into<String>, model: ReferenceModel) -> Self {
+        Self {
+            format: FORMAT.to_string(),
+            version: VERSION,
+            units: "mm".to_string(),
+            monomial_order: MONOMIAL_ORDER.to_string(),
+            method: method.into(),
+            model,
+        }
+    }
+
+    pub fn save(&self, path: &Path) -> Result<(), ModelFileError> {
+        let json = serde_json::to_string_pretty(self).expect("a model serialises");
+        write_atomically(path, json.as_bytes())
+            .map_err(|e| ModelFileError::new(path, e.to_string()))
+    }
+
+    pub fn load(path: &Path) -> Result<Self, ModelFileError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ModelFileError::new(path, format!("cannot read: {e}")))?;
+        let file: Self =
+            serde_json::from_str(&text).map_err(|e| ModelFileError::new(path, e.to_string()))?;
+        if file.format != FORMAT {
+            return Err(ModelFileError::new(
+                path,
+                format!("format '{}' is not '{FORMAT}'", file.format),
+            ));
+        }
+        if file.version != VERSION {
+            return Err(ModelFileError::new(
+                path,
+                format!(
+                    "version {} is not supported (this build reads version {VERSION})",
+                    file.version
+                ),
+            ));
+        }
+        if file.units != "mm" {
+            return Err(ModelFileError::new(
+                path,
+                format!("units '{}' (only mm are supported)", file.units),
+            ));
+        }
+        if let ReferenceModel::Stack { profiles } = &file.model {
+            stack_of(profiles).map_err(|e| ModelFileError::new(path, e.to_string()))?;
+        }
+        Ok(file)
+    }
+}
+
+/// The piecewise 3-D model of a stack's profiles.
+pub fn stack_of(profiles: &[StackProfile]) -> Result<ProfileStack, StackError> {
+    ProfileStack::new(
+        profiles
+            .iter()
+            .map(|p| Profile {
+                x: p.x,
+                model: p.fitted.ip.clone(),
+            })
+            .collect(),
+    )
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {problem}")]
+pub struct ModelFileError {
+    pub path: String,
+    pub problem: String,
+}
+
+impl ModelFileError {
+    fn new(path: &Path, problem: impl Into<String>) -> Self {
+        Self {
+            path: path.display().to_string(),
+            problem: problem.into(),
+        }
+    }
+}
