@@ -13,8 +13,12 @@ use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{project_to_zero_set, ZeroSetSamples};
 use crate::geometry::small;
 
-/// How many sampled seeds are tried before the slow, robust fallback.
+/// How many sampled seeds are tried before the slow, robust fallback, and how many samples are looked at to
+/// find them.
 const SEEDS_TRIED: usize = 8;
+const SEEDS_SCANNED: usize = 400;
+/// Seeds closer together than this fraction of their distance from the point lead to the same foot.
+const SEED_SEPARATION: f64 = 0.1;
 /// Newton stops when a step is below this many millimetres: convergence is quadratic there, so the error left is
 /// of the order of its square, far below the 1e-6 mm the station promises.
 const STEP_TOLERANCE_MM: f64 = 1e-8;
@@ -82,10 +86,20 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
                 best = Some(foot);
             }
         }
-        for seed in self.samples.nearest_iter(p).take(SEEDS_TRIED) {
-            if best.is_some_and(|b| (p - seed).norm() > b.distance.abs() + reach) {
+        // Refined samples crowd around a sharp edge: seeds next to one already tried would only find the same
+        // local minimum again, so only seeds a fair fraction of the distance apart are tried.
+        let mut tried: Vec<SVector<f64, N>> = Vec::with_capacity(SEEDS_TRIED);
+        for seed in self.samples.nearest_iter(p).take(SEEDS_SCANNED) {
+            if tried.len() == SEEDS_TRIED
+                || best.is_some_and(|b| (p - seed).norm() > b.distance.abs() + reach)
+            {
                 break;
             }
+            let apart = SEED_SEPARATION * (p - seed).norm();
+            if tried.iter().any(|t| (t - seed).norm() < apart) {
+                continue;
+            }
+            tried.push(seed);
             if let Some(foot) = self.checked_newton(p, &seed, &seed) {
                 if best.is_none_or(|b| foot.distance.abs() < b.distance.abs()) {
                     best = Some(foot);

@@ -5,6 +5,7 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
 use super::*;
+use crate::geometry::distance::paper_distance;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::normals::ordered_profile_normals;
 use crate::geometry::trace::{resample_closed, trace_closed_curve};
@@ -107,23 +108,78 @@ pub(crate) fn naca_2412_truth_and_scan(
 }
 
 #[test]
-fn naca_2412_section_at_degrees_4_to_10() {
+fn naca_2412_at_degree_8_lies_within_30_um_everywhere_and_10_um_away_from_the_edges() {
+    // The target; plain 3L misses by about 0.4 mm at the trailing edge (see BENCHMARKS.md for the table
+    // of degrees 4 to 10).
     let (truth, measured) = naca_2412_truth_and_scan(20_000, 400);
-    for degree in [4, 6, 8, 10] {
-        for method in [FitMethod::ThreeL, FitMethod::Ridge, FitMethod::Orthogonal] {
-            let normals = ordered_profile_normals(&measured);
-            let options = FitOptions::new(degree, method);
-            let fitted = fit_ip(&measured, &normals, &options).unwrap();
-            let (max, rms, at) = deviation_from(&fitted, &truth);
-            let inner: Vec<_> = truth
-                .iter()
-                .copied()
-                .filter(|p| p.x > 5.0 && p.x < 95.0)
-                .collect();
-            let (inner_max, _, inner_at) = deviation_from(&fitted, &inner);
-            eprintln!("naca degree {degree} {method:?}: max {max:.4} at ({:.2},{:.3}) rms {rms:.4}; inner max {inner_max:.4} at ({:.1},{:.2}); comps {} cond {:.1e} iters {}", at.x, at.y, inner_at.x, inner_at.y, fitted.stats.zero_set_components, fitted.stats.condition_number, fitted.stats.refinement_iterations);
+    let fitted = fit_profile(&measured, 8, FitMethod::default());
+    let (max, rms, at) = deviation_from(&fitted, &truth);
+    assert!(max <= 0.030, "max {max} mm at {at}, RMS {rms}");
+    let away_from_edges: Vec<_> = truth
+        .iter()
+        .copied()
+        .filter(|p| p.x > 5.0 && p.x < 95.0)
+        .collect();
+    let (inner_max, _, inner_at) = deviation_from(&fitted, &away_from_edges);
+    assert!(
+        inner_max <= 0.010,
+        "max {inner_max} mm at {inner_at} away from the edges"
+    );
+    let plain = fit_profile(&measured, 8, FitMethod::ThreeL);
+    let (plain_max, _, _) = deviation_from(&plain, &truth);
+    assert!(
+        plain_max > 3.0 * max,
+        "the default must beat plain 3L clearly: {plain_max} vs {max}"
+    );
+}
+
+#[test]
+fn paper_distances_agree_with_exact_ones_where_they_answer_and_flag_the_rest() {
+    // Points 0.5 mm outside and inside the true NACA 2412 section, against a degree-8 fit: where the paper's
+    // approximation answers it is never nearer than the exact foot (its foot is on the curve) and within a few
+    // percent of it (its secant through the axis intercepts is not the tangent: on a 12% section an axis
+    // projection can travel tens of millimetres); where its projections reach the other face (near the edges,
+    // and where a surface runs nearly parallel to an axis) the point is flagged instead of measured.
+    let (truth, measured) = naca_2412_truth_and_scan(4_000, 400);
+    let fitted = fit_profile(&measured, 8, FitMethod::default());
+    let normals = ordered_profile_normals(&truth);
+    let samples = ZeroSetSamples::new(&fitted.model, &fitted.domain.scaled(2.0), 512);
+    let exact = ExactDistance::new(&fitted.model, &samples);
+    let (mut failed_near_edges, mut failed_elsewhere, mut answered) = (0, 0, 0);
+    for offset in [-0.5, 0.5] {
+        for (p, n) in truth.iter().zip(&normals) {
+            let q = p + n * offset;
+            let reference = exact.foot(&q, None).unwrap().distance;
+            match paper_distance(&fitted.model, &q, 400.0) {
+                Ok(foot) => {
+                    answered += 1;
+                    assert!(
+                        foot.distance.abs() >= reference.abs() - 1e-9,
+                        "at {q}: paper {foot:?} exact {:?}",
+                        exact.foot(&q, None)
+                    );
+                    if p.x > 5.0 && p.x < 95.0 {
+                        let relative = (foot.distance - reference).abs() / reference.abs();
+                        assert!(relative < 0.05, "at {q}: {} vs {reference}", foot.distance);
+                    }
+                }
+                Err(_) if p.x < 5.0 || p.x > 95.0 => failed_near_edges += 1,
+                Err(_) => failed_elsewhere += 1,
+            }
         }
     }
+    assert!(
+        failed_near_edges > 0,
+        "the edges must trip the failure checks"
+    );
+    assert!(answered > 7_000, "answered {answered} of 8000");
+    // Measured: 170 of 2300 points within 5% of chord of an edge fail, and 229 of 5700 elsewhere, most of them
+    // between 10% and 40% of chord, where the surfaces run nearly parallel to the chord and the projection along
+    // it finds the section only through the other face.
+    assert!(
+        failed_elsewhere > 0 && failed_elsewhere < failed_near_edges * 3,
+        "{failed_elsewhere} elsewhere"
+    );
 }
 
 /// Checks that no part of the zero set enters the disk of radius `distance` around `p` (F keeps the sign of
