@@ -251,3 +251,78 @@ fn a_chain_of_feet_does_not_creep_onto_a_spurious_branch() {
         );
     }
 }
+
+mod properties {
+    use super::*;
+    use nalgebra::Rotation2;
+    use proptest::prelude::*;
+
+    /// An ordered closed profile: an ellipse with a bump, 150 points, with 2 um of seeded noise.
+    fn bumpy_ellipse() -> Vec<Vector2<f64>> {
+        let clean: Vec<Vector2<f64>> = (0..150)
+            .map(|i| {
+                let t = i as f64 / 150.0 * std::f64::consts::TAU;
+                let r = 1.0 + 0.15 * (3.0 * t).cos();
+                Vector2::new(40.0 * r * t.cos(), 25.0 * r * t.sin())
+            })
+            .collect();
+        let normals = ordered_profile_normals(&clean);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        let noise = Normal::new(0.0, 0.002).unwrap();
+        clean
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| p + n * noise.sample(&mut rng))
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+
+        #[test]
+        fn a_fit_of_moved_and_scaled_points_is_the_moved_fit(
+            angle in -3.1f64..3.1,
+            dx in -500.0f64..500.0,
+            dy in -500.0f64..500.0,
+            scale in 0.2f64..5.0,
+            method in prop_oneof![Just(FitMethod::ThreeL), Just(FitMethod::Ridge), Just(FitMethod::Orthogonal)],
+        ) {
+            let points = bumpy_ellipse();
+            let motion = |p: &Vector2<f64>| Rotation2::new(angle) * p * scale + Vector2::new(dx, dy);
+            let moved: Vec<_> = points.iter().map(motion).collect();
+            let original = fit_profile(&points, 4, method);
+            let refit = fit_profile(&moved, 4, method);
+            // Probe points around the profile, inside and out, mapped by the same motion.
+            let probes: Vec<Vector2<f64>> = points.iter().step_by(10).flat_map(|p| [p * 0.97, p * 1.03]).collect();
+            for q in &probes {
+                let d1 = original.model.value_gradient(q);
+                let d2 = refit.model.value_gradient(&motion(q));
+                // F is in mm (the model's normalisation), so values scale with the motion's scale.
+                prop_assert!((d2.0 - scale * d1.0).abs() < 1e-6 * scale * (1.0 + d1.0.abs()), "{} vs {}", d2.0, scale * d1.0);
+            }
+            prop_assert!((refit.stats.rms_distance_mm - scale * original.stats.rms_distance_mm).abs() < 1e-7 * scale);
+        }
+
+        #[test]
+        fn the_exact_distance_never_exceeds_another_foot_on_the_curve(
+            seed in 0u64..1000,
+            offset in -3.0f64..3.0,
+        ) {
+            let points = bumpy_ellipse();
+            let fitted = fit_profile(&points, 4, FitMethod::default());
+            let samples = ZeroSetSamples::new(&fitted.model, &fitted.domain.scaled(2.0), 256);
+            let exact = ExactDistance::new(&fitted.model, &samples);
+            let p = points[(seed as usize) % points.len()];
+            let q = p * (1.0 + offset / 30.0);
+            let d = exact.foot(&q, None).unwrap().distance.abs();
+            // Any point of the zero set bounds the distance: every sample, and the paper's foot where it answers.
+            for s in samples.points() {
+                prop_assert!(d <= (q - s).norm() + 1e-9);
+            }
+            if let Ok(foot) = paper_distance(&fitted.model, &q, 400.0) {
+                prop_assert!(d <= foot.distance.abs() + 1e-9);
+            }
+            prop_assert!(d >= 0.0);
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Running the real binary and reading what it wrote.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn config(relative: &str) -> String {
+    repo().join("config").join(relative).display().to_string()
+}
+
+/// What a run of the binary printed, and whether it succeeded.
+pub struct Run {
+    pub success: bool,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+pub fn zeroset(args: &[&str]) -> Run {
+    let output = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("the zeroset binary runs");
+    Run {
+        success: output.status.success(),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
+/// Runs and insists on success, showing what it printed otherwise.
+pub fn zeroset_ok(args: &[&str]) -> String {
+    let run = zeroset(args);
+    assert!(
+        run.success,
+        "zeroset {args:?} failed:\n{}\n{}",
+        run.stdout, run.stderr
+    );
+    run.stdout
+}
+
+/// The deviation_mm column of a deviations file (None where a point has no deviation), with the header checked.
+pub fn deviations(path: &Path) -> Vec<Option<f64>> {
+    let text = std::fs::read_to_string(path).expect("deviations file");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let column = header
+        .iter()
+        .position(|c| *c == "deviation_mm")
+        .expect("a deviation_mm column");
+    lines
+        .map(|l| {
+            let field = l.split(',').nth(column).expect("field");
+            (!field.is_empty()).then(|| field.parse().expect("a number"))
+        })
+        .collect()
+}
+
+pub fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len() as f64
+}
