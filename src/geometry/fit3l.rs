@@ -24,6 +24,9 @@ use super::poly::{factorial, Basis, Poly, MAX_DEGREE};
 use super::sampling::{project_to_zero_set, Aabb, ZeroSetSamples};
 use super::small;
 
+/// Default zero-set sampling for the statistics: cells along the longest side of twice the data's box.
+const PROFILE_SAMPLING_CELLS: usize = 512;
+const SURFACE_SAMPLING_CELLS: usize = 64;
 /// The largest offsets tried when none is given (fractions of the RMS radius), for 3L and ridge fits.
 const OFFSET_CANDIDATES: [f64; 4] = [0.003, 0.01, 0.03, 0.1];
 /// The largest offsets of the ridge fits that start the orthogonal refinement: the refinement finds a local
@@ -70,8 +73,9 @@ pub struct FitOptions {
     /// `None`: for 3L and ridge, the paper's procedure of varying the level sets and keeping the most accurate fit;
     /// for the orthogonal method, the start measured best in BENCHMARKS.md.
     pub offset: Option<f64>,
-    /// Grid cells along the longest side of the box in which the zero set is sampled for the statistics.
-    pub sampling_cells: usize,
+    /// Grid cells along the longest side of the box in which the zero set is sampled for the statistics;
+    /// `None` for the default of the dimension (a fine grid for profiles, a coarser one for surfaces).
+    pub sampling_cells: Option<usize>,
 }
 
 impl FitOptions {
@@ -81,7 +85,7 @@ impl FitOptions {
             method,
             ridge: 1e-5,
             offset: None,
-            sampling_cells: if degree > 0 { 512 } else { 1 },
+            sampling_cells: None,
         }
     }
 }
@@ -211,7 +215,12 @@ pub fn fit_ip<const N: usize>(
             .fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
                 (lo.min(c), hi.max(c))
             });
-        let mut stats = measure(&model, points, &domain, options.sampling_cells);
+        let cells = options.sampling_cells.unwrap_or(if N == 2 {
+            PROFILE_SAMPLING_CELLS
+        } else {
+            SURFACE_SAMPLING_CELLS
+        });
+        let mut stats = measure(&model, points, &domain, cells);
         stats.condition_number = condition_number;
         stats.offset_min_mm = min_offset * frame.scale;
         stats.offset_max_mm = max_offset * frame.scale;

@@ -85,32 +85,31 @@ fn push_exponents_of_total<const N: usize>(
     }
 }
 
-/// Powers x^e and their first and second derivatives for every variable, e = 0..=degree.
+/// Powers x^e of every variable, e = 0..=degree (derivatives of a monomial are formed from these on the fly:
+/// d/dx x^e = e x^(e-1)), kept on the stack.
 struct Powers<const N: usize> {
     value: [[f64; MAX_DEGREE + 1]; N],
-    first: [[f64; MAX_DEGREE + 1]; N],
-    second: [[f64; MAX_DEGREE + 1]; N],
 }
 
 impl<const N: usize> Powers<N> {
+    #[inline]
     fn new(p: &SVector<f64, N>, degree: usize) -> Self {
-        let mut value = [[0.0; MAX_DEGREE + 1]; N];
-        let mut first = [[0.0; MAX_DEGREE + 1]; N];
-        let mut second = [[0.0; MAX_DEGREE + 1]; N];
-        for k in 0..N {
-            value[k][0] = 1.0;
+        let mut value = [[1.0; MAX_DEGREE + 1]; N];
+        for (k, row) in value.iter_mut().enumerate() {
             for e in 1..=degree {
-                value[k][e] = value[k][e - 1] * p[k];
-                first[k][e] = e as f64 * value[k][e - 1];
-                if e >= 2 {
-                    second[k][e] = (e * (e - 1)) as f64 * value[k][e - 2];
-                }
+                row[e] = row[e - 1] * p[k];
             }
         }
-        Self {
-            value,
-            first,
-            second,
+        Self { value }
+    }
+
+    /// x_k^e, and zero for negative powers (the derivative of a constant).
+    #[inline]
+    fn get(&self, k: usize, e: usize, lowered: usize) -> f64 {
+        if e < lowered {
+            0.0
+        } else {
+            self.value[k][e - lowered]
         }
     }
 }
@@ -166,16 +165,15 @@ impl<const N: usize> Poly<N> {
 
     pub fn value(&self, p: &SVector<f64, N>) -> f64 {
         let powers = Powers::<N>::new(p, self.basis.degree);
-        self.basis
-            .exponents
-            .iter()
-            .zip(&self.coeffs)
-            .map(|(e, c)| {
-                c * (0..N)
-                    .map(|k| powers.value[k][e[k] as usize])
-                    .product::<f64>()
-            })
-            .sum()
+        let mut value = 0.0;
+        for (e, &c) in self.basis.exponents.iter().zip(&self.coeffs) {
+            let mut term = c;
+            for k in 0..N {
+                term *= powers.value[k][e[k] as usize];
+            }
+            value += term;
+        }
+        value
     }
 
     pub fn value_gradient(&self, p: &SVector<f64, N>) -> (f64, SVector<f64, N>) {
@@ -186,7 +184,8 @@ impl<const N: usize> Poly<N> {
             let v: [f64; N] = std::array::from_fn(|k| powers.value[k][e[k] as usize]);
             value += c * v.iter().product::<f64>();
             for k in 0..N {
-                let mut term = c * powers.first[k][e[k] as usize];
+                let ek = e[k] as usize;
+                let mut term = c * ek as f64 * powers.get(k, ek, 1);
                 for (j, vj) in v.iter().enumerate() {
                     if j != k {
                         term *= vj;
@@ -209,14 +208,29 @@ impl<const N: usize> Poly<N> {
         for (e, &c) in self.basis.exponents.iter().zip(&self.coeffs) {
             let idx: [usize; N] = std::array::from_fn(|k| e[k] as usize);
             let v: [f64; N] = std::array::from_fn(|k| powers.value[k][idx[k]]);
+            let d1: [f64; N] = std::array::from_fn(|k| idx[k] as f64 * powers.get(k, idx[k], 1));
+            let d2: [f64; N] = std::array::from_fn(|k| {
+                (idx[k] * idx[k].saturating_sub(1)) as f64 * powers.get(k, idx[k], 2)
+            });
             value += c * v.iter().product::<f64>();
+            // Products of the other variables' powers: with N at most 3 these are at most two factors, written
+            // out so that the hot path of the exact distance has no loops over filtered indices.
+            let others = |skip: usize| -> f64 {
+                let mut product = 1.0;
+                for (j, vj) in v.iter().enumerate() {
+                    if j != skip {
+                        product *= vj;
+                    }
+                }
+                product
+            };
             for k in 0..N {
-                let others: f64 = (0..N).filter(|&j| j != k).map(|j| v[j]).product();
-                gradient[k] += c * powers.first[k][idx[k]] * others;
-                hessian[(k, k)] += c * powers.second[k][idx[k]] * others;
+                let rest_k = others(k);
+                gradient[k] += c * d1[k] * rest_k;
+                hessian[(k, k)] += c * d2[k] * rest_k;
                 for l in (k + 1)..N {
-                    let rest: f64 = (0..N).filter(|&j| j != k && j != l).map(|j| v[j]).product();
-                    let mixed = c * powers.first[k][idx[k]] * powers.first[l][idx[l]] * rest;
+                    let rest = if N == 2 { 1.0 } else { v[3 - k - l] };
+                    let mixed = c * d1[k] * d1[l] * rest;
                     hessian[(k, l)] += mixed;
                     hessian[(l, k)] += mixed;
                 }

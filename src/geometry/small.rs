@@ -12,12 +12,25 @@ pub fn solve<const N: usize, const K: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SMatrix<f64, N, K>,
 ) -> Option<SMatrix<f64, N, K>> {
-    let mut a = *a;
-    let mut b = *b;
     let scale = a.amax();
     if scale == 0.0 || !scale.is_finite() {
         return None;
     }
+    if N == 2 {
+        // Cramer's rule: the distance hot path solves a 2x2 system at every Newton step.
+        let det = a[(0, 0)] * a[(1, 1)] - a[(0, 1)] * a[(1, 0)];
+        if det.abs() <= scale * scale * 1e-14 {
+            return None;
+        }
+        let mut x = SMatrix::<f64, N, K>::zeros();
+        for k in 0..K {
+            x[(0, k)] = (b[(0, k)] * a[(1, 1)] - a[(0, 1)] * b[(1, k)]) / det;
+            x[(1, k)] = (a[(0, 0)] * b[(1, k)] - b[(0, k)] * a[(1, 0)]) / det;
+        }
+        return Some(x);
+    }
+    let mut a = *a;
+    let mut b = *b;
     for col in 0..N {
         let pivot = (col..N).max_by(|&i, &j| a[(i, col)].abs().total_cmp(&a[(j, col)].abs()))?;
         if a[(pivot, col)].abs() <= scale * 1e-14 {
@@ -64,6 +77,14 @@ pub fn symmetric_eigen<const N: usize>(m: &SMatrix<f64, N, N>) -> Vec<(f64, SVec
 mod tests {
     use super::*;
     use nalgebra::{Matrix3, Vector3};
+
+    #[test]
+    fn solves_two_by_two_systems_and_refuses_singular_ones() {
+        let a = nalgebra::Matrix2::new(0.0, 2.0, 3.0, 1.0);
+        let x = nalgebra::Vector2::new(1.5, -2.0);
+        assert!((solve(&a, &(a * x)).unwrap() - x).norm() < 1e-12);
+        assert!(solve(&nalgebra::Matrix2::new(1.0, 2.0, 2.0, 4.0), &x).is_none());
+    }
 
     #[test]
     fn solves_a_system_that_needs_pivoting() {

@@ -14,7 +14,7 @@ use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 pub use exact::ExactDistance;
-pub(crate) use exact::{crosses_zero_set, lagrange_newton};
+pub(crate) use exact::{crosses_zero_set, lagrange_newton, lagrange_newton_to};
 pub use paper::paper_distance;
 pub use stack::StackDistance;
 
