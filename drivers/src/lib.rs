@@ -1,7 +1,13 @@
 //! zeroset-drivers: the I++ DME protocol codec, the `Machine` trait and the serial and TCP transports.
 //!
-//! So far the wire layer: [`wire`] holds the typed lines of I++ DME 1.4.3 (commands and responses) with
-//! their exact text form, and [`codec`] frames them on a byte stream for tokio.
+//! - [`wire`]: the typed lines of I++ DME 1.4.3 (commands and responses) with their exact text form;
+//! - [`codec`]: frames them on a byte stream for tokio;
+//! - [`machine`]: the [`Machine`](machine::Machine) trait the station drives, its values and errors;
+//! - [`client`]: the I++ client implementing it over any byte stream;
+//! - [`transport`]: opening TCP, serial and pseudo-terminal links.
 
+pub mod client;
 pub mod codec;
+pub mod machine;
+pub mod transport;
 pub mod wire;
