@@ -1,7 +1,7 @@
-//! Bench inputs, made from public data: the quartic seed 003 publishes for profile 3, and a smooth closed 3-D
-//! surface, both sampled with seeded 2 um noise along the normal.
+//! Bench inputs, made from public data: the quartic seed 003 publishes for profile 3, sampled with seeded 2 um
+//! noise along the normal.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector2;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use zeroset::geometry::implicit::{Implicit, IpModel};
@@ -24,22 +24,5 @@ pub fn profile_3_scan(count: usize, offset: f64) -> Vec<Vector2<f64>> {
     resample_closed(&section, count)
         .into_iter()
         .map(|p| p + model.value_gradient(&p).1.normalize() * (offset + noise.sample(&mut rng)))
-        .collect()
-}
-
-/// `count` points on r(theta, phi) = 50 (1 + 0.1 sin 3 theta cos 2 phi) mm, with 2 um noise along the radius.
-pub fn blob(count: usize) -> Vec<Vector3<f64>> {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(6);
-    let noise = Normal::new(0.0, 0.002).expect("sigma");
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..count)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
-            let theta = z.acos();
-            let phi = golden * i as f64;
-            let r = 50.0 * (1.0 + 0.1 * (3.0 * theta).sin() * (2.0 * phi).cos())
-                + noise.sample(&mut rng);
-            Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), z) * r
-        })
         .collect()
 }

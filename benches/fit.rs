@@ -5,14 +5,34 @@
 mod data;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
 use std::time::Duration;
 use zeroset::geometry::fit3l::{fit_ip, FitMethod, FitOptions};
 use zeroset::geometry::normals::{ordered_profile_normals, pca_normals};
 
+/// `count` points on r(theta, phi) = 50 (1 + 0.1 sin 3 theta cos 2 phi) mm, with 2 um noise along the radius.
+pub fn blob(count: usize) -> Vec<Vector3<f64>> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(6);
+    let noise = Normal::new(0.0, 0.002).expect("sigma");
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..count)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+            let theta = z.acos();
+            let phi = golden * i as f64;
+            let r = 50.0 * (1.0 + 0.1 * (3.0 * theta).sin() * (2.0 * phi).cos())
+                + noise.sample(&mut rng);
+            Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), z) * r
+        })
+        .collect()
+}
+
 fn fits(c: &mut Criterion) {
     let profile = data::profile_3_scan(10_000, 0.0);
     let profile_normals = ordered_profile_normals(&profile);
-    let surface = data::blob(10_000);
+    let surface = blob(10_000);
     let surface_normals = pca_normals(&surface);
     let mut group = c.benchmark_group("fit 10 000 points");
     group

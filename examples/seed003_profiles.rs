@@ -7,6 +7,7 @@
 //!   planes x = 100 ... 500 mm, for blades A, B and C (B below A by 0.4 mm at the root growing to 1.0 mm at the
 //!   tip, C above by as much), to fit a profile stack. "Below" is a shift along -z: an offset along the normal
 //!   cannot exceed half the thickness of a trailing edge without passing through it.
+//!
 //! Every scan has 2 um of seeded Gaussian probe noise along the normal.
 //!
 //!     cargo run --release --example seed003_profiles

@@ -168,8 +168,8 @@ impl<const N: usize> Poly<N> {
         let mut value = 0.0;
         for (e, &c) in self.basis.exponents.iter().zip(&self.coeffs) {
             let mut term = c;
-            for k in 0..N {
-                term *= powers.value[k][e[k] as usize];
+            for (row, &power) in powers.value.iter().zip(e) {
+                term *= row[power as usize];
             }
             value += term;
         }
@@ -392,7 +392,7 @@ mod tests {
         let (_, g, h) = f.value_gradient_hessian(&p);
         assert_eq!(
             g,
-            Vector2::new(2.0 + 8.0 * 2.0 + 5.0 * -1.0, 3.0 + 5.0 * 2.0 + 12.0 * -1.0)
+            Vector2::new(2.0 + 8.0 * 2.0 - 5.0, 3.0 + 5.0 * 2.0 - 12.0)
         );
         assert_eq!(h, nalgebra::Matrix2::new(8.0, 5.0, 5.0, 12.0));
     }

@@ -226,7 +226,8 @@ impl<const N: usize> Grid<N> {
                 .map(|j| normals[i].dot(&normals[j]).clamp(-1.0, 1.0).acos())
                 .fold(0.0, f64::max);
             let bend = (curvature * side).max(turn_to_neighbour);
-            if !(bend > CURVED_CELL_BEND) {
+            // NaN (a vanishing gradient) counts as not curved.
+            if bend.is_nan() || bend <= CURVED_CELL_BEND {
                 continue;
             }
             let home: [usize; N] = std::array::from_fn(|k| {

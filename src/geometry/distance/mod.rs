@@ -13,8 +13,10 @@ mod stack;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
+#[cfg(test)]
+pub(crate) use exact::lagrange_newton_to;
 pub use exact::ExactDistance;
-pub(crate) use exact::{crosses_zero_set, lagrange_newton, lagrange_newton_to};
+pub(crate) use exact::{crosses_zero_set, lagrange_newton};
 pub use paper::paper_distance;
 pub use stack::StackDistance;
 

@@ -76,9 +76,13 @@ impl<'a> StackDistance<'a> {
                 }
             }
         }
-        for j in first..=(last + 1) {
-            let plane = &profiles[j];
-            let exact = ExactDistance::new(&plane.model, &self.profiles[j]);
+        let planes = profiles
+            .iter()
+            .zip(&self.profiles)
+            .skip(first)
+            .take(last + 2 - first);
+        for (plane, plane_samples) in planes {
+            let exact = ExactDistance::new(&plane.model, plane_samples);
             if let Ok(in_plane) = exact.foot(&Vector2::new(p.y, p.z), None) {
                 let point = Vector3::new(plane.x, in_plane.point.x, in_plane.point.y);
                 let unsigned = (p - point).norm();
