@@ -167,3 +167,66 @@ fn a_stack_of_five_profiles_measures_blade_b_below_blade_a() {
         "the root profile's largest deviation is {root_max} mm"
     );
 }
+
+/// Points on the ellipsoid x^2/40^2 + y^2/30^2 + z^2/20^2 = 1 (mm), moved `offset` mm along the outward normal,
+/// as an x,y,z point file.
+fn ellipsoid_csv(path: &std::path::Path, count: usize, offset: f64) {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut text = String::from("x,y,z\n");
+    for i in 0..count {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+        let r = (1.0 - z * z).sqrt();
+        let phi = golden * i as f64;
+        let (ux, uy, uz) = (r * phi.cos(), r * phi.sin(), z);
+        let p = [40.0 * ux, 30.0 * uy, 20.0 * uz];
+        let n = [p[0] / 1600.0, p[1] / 900.0, p[2] / 400.0];
+        let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let q: Vec<String> = (0..3)
+            .map(|k| format!("{:.6}", p[k] + offset * n[k] / length))
+            .collect();
+        text.push_str(&q.join(","));
+        text.push('\n');
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let master = dir.path().join("master.csv");
+    let part = dir.path().join("part.csv");
+    ellipsoid_csv(&master, 1500, 0.0);
+    ellipsoid_csv(&part, 500, 0.25);
+    let model = dir.path().join("surface.json");
+    let fit = zeroset_ok(&[
+        "fit",
+        "ip",
+        "--points",
+        master.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(fit.contains("(surface) to 1500 points"), "{fit}");
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert_eq!(saved["model"]["kind"], "ip-surface");
+    let out = dir.path().join("deviations.csv");
+    zeroset_ok(&[
+        "deviate",
+        "--model",
+        model.to_str().unwrap(),
+        "--points",
+        part.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let values: Vec<f64> = deviations(&out)
+        .into_iter()
+        .map(|d| d.expect("every exact distance"))
+        .collect();
+    assert!(
+        values.iter().all(|d| (d - 0.25).abs() < 0.001),
+        "an offset of 0.25 mm everywhere: {:?}",
+        &values[..5]
+    );
+}
