@@ -1,46 +1,53 @@
 //! Fitting the master's points and measuring the other blades against the model, through the binary.
 
-use crate::support::{config, deviations, mean, zeroset_ok};
+use std::path::PathBuf;
+
+use crate::support::{config, deviate, fit_ip, mean};
+
+/// The exact deviations of a point file, every point required to have one.
+fn exact_deviations(model: &std::path::Path, points: &str, out: &std::path::Path) -> Vec<f64> {
+    let (values, _) = deviate(model, points, None, out);
+    values
+        .into_iter()
+        .map(|d| d.expect("every exact distance"))
+        .collect()
+}
+
+fn rms(values: &[f64]) -> f64 {
+    (values.iter().map(|d| d * d).sum::<f64>() / values.len() as f64).sqrt()
+}
+
+fn largest(values: &[f64]) -> f64 {
+    values.iter().fold(0.0f64, |m, d| m.max(d.abs()))
+}
 
 #[test]
 fn blades_b_and_c_deviate_by_the_simulated_0_8_mm_and_blade_a_by_its_noise() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("a.json");
-    let fit = zeroset_ok(&[
-        "fit",
-        "ip",
-        "--points",
+    let (fit, saved) = fit_ip(
         &config("profiles/seed003-profile3-blade-a.csv"),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+        &[],
+        &model,
+    );
     assert!(
         fit.contains("fitted a degree-4 implicit polynomial"),
         "{fit}"
     );
-    let saved: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(saved["units"], "mm");
     assert_eq!(saved["version"], 1);
     assert_eq!(saved["model"]["kind"], "ip-profile");
-    let rms = saved["model"]["fit"]["rms_distance_mm"].as_f64().unwrap();
+    let fit_rms = saved["model"]["fit"]["rms_distance_mm"].as_f64().unwrap();
     assert!(
-        rms > 0.001 && rms < 0.003,
-        "the fit follows the 2 um noise: RMS {rms} mm"
+        fit_rms > 0.001 && fit_rms < 0.003,
+        "the fit follows the 2 um noise: RMS {fit_rms} mm"
     );
     for (blade, expected) in [("a", 0.0), ("b", -0.8), ("c", 0.8)] {
+        let points = config(&format!("profiles/seed003-profile3-blade-{blade}.csv"));
         let out = dir.path().join(format!("{blade}.csv"));
-        let printed = zeroset_ok(&[
-            "deviate",
-            "--model",
-            model.to_str().unwrap(),
-            "--points",
-            &config(&format!("profiles/seed003-profile3-blade-{blade}.csv")),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let (values, printed) = deviate(&model, &points, None, &out);
         assert!(printed.contains("n = 400"), "{printed}");
-        let values: Vec<f64> = deviations(&out)
+        let values: Vec<f64> = values
             .into_iter()
             .map(|d| d.expect("every exact distance"))
             .collect();
@@ -60,24 +67,20 @@ fn blades_b_and_c_deviate_by_the_simulated_0_8_mm_and_blade_a_by_its_noise() {
 #[test]
 fn the_paper_distance_against_the_published_quartic_agrees_with_the_exact_one() {
     let dir = tempfile::tempdir().unwrap();
-    let model = config("models/seed003-profile3.json");
+    let model = PathBuf::from(config("models/seed003-profile3.json"));
     let points = config("profiles/seed003-profile3-blade-b.csv");
-    let mut by_method = Vec::new();
-    for method in ["exact", "paper", "taubin"] {
-        let out = dir.path().join(format!("{method}.csv"));
-        zeroset_ok(&[
-            "deviate",
-            "--model",
-            &model,
-            "--points",
-            &points,
-            "--distance",
-            method,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        by_method.push(deviations(&out));
-    }
+    let by_method: Vec<Vec<Option<f64>>> = ["exact", "paper", "taubin"]
+        .iter()
+        .map(|m| {
+            deviate(
+                &model,
+                &points,
+                Some(m),
+                &dir.path().join(format!("{m}.csv")),
+            )
+            .0
+        })
+        .collect();
     let (exact, paper, taubin) = (&by_method[0], &by_method[1], &by_method[2]);
     let mut answered = 0;
     for i in 0..exact.len() {
@@ -92,8 +95,12 @@ fn the_paper_distance_against_the_published_quartic_agrees_with_the_exact_one() 
             );
             assert!((p - e).abs() < 0.01, "point {i}: paper {p} vs exact {e}");
         }
-        // Taubin's estimate is first order: off by far more than the paper's on a 0.8 mm offset.
-        assert!(taubin[i].is_some());
+        let t = taubin[i].expect("Taubin answers where the gradient does not vanish");
+        assert_eq!(
+            t.signum(),
+            e.signum(),
+            "point {i}: Taubin {t} on the other side"
+        );
     }
     assert!(
         answered > 300,
@@ -105,20 +112,9 @@ fn the_paper_distance_against_the_published_quartic_agrees_with_the_exact_one() 
 fn a_stack_of_five_profiles_measures_blade_b_below_blade_a() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("stack.json");
-    let fit = zeroset_ok(&[
-        "fit",
-        "ip",
-        "--stack",
-        "--degree",
-        "8",
-        "--points",
-        &config("profiles/naca-blade-a-5-profiles.csv"),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let points = config("profiles/naca-blade-a-5-profiles.csv");
+    let (fit, saved) = fit_ip(&points, &["--stack", "--degree", "8"], &model);
     assert_eq!(fit.matches("fitted a degree-8").count(), 5, "{fit}");
-    let saved: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(saved["model"]["kind"], "ip-stack");
     let xs: Vec<f64> = saved["model"]["profiles"]
         .as_array()
@@ -128,43 +124,31 @@ fn a_stack_of_five_profiles_measures_blade_b_below_blade_a() {
         .collect();
     assert_eq!(xs, vec![100.0, 200.0, 300.0, 400.0, 500.0]);
     let measure = |blade: &str| {
-        let out = dir.path().join(format!("{blade}.csv"));
-        zeroset_ok(&[
-            "deviate",
-            "--model",
-            model.to_str().unwrap(),
-            "--points",
-            &config(&format!("profiles/naca-blade-{blade}-5-profiles.csv")),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        deviations(&out)
-            .into_iter()
-            .map(|d| d.expect("every exact distance"))
-            .collect::<Vec<f64>>()
+        let points = config(&format!("profiles/naca-blade-{blade}-5-profiles.csv"));
+        exact_deviations(&model, &points, &dir.path().join(format!("{blade}.csv")))
     };
     let a = measure("a");
-    let rms_a = (a.iter().map(|d| d * d).sum::<f64>() / a.len() as f64).sqrt();
     assert!(
-        rms_a < 0.01,
-        "blade A against its own model: RMS {rms_a} mm"
+        rms(&a) < 0.01,
+        "blade A against its own model: RMS {} mm",
+        rms(&a)
     );
     // Blade B is shifted 0.4 mm (root) to 1.0 mm (tip) along -z: no point can be farther than that, and the
     // points of the tip profile (the last 400) face the shift along their normals by up to the full 1.0 mm.
     let b = measure("b");
     assert!(
-        b.iter().all(|d| d.abs() <= 1.0 + 0.01),
+        largest(&b) <= 1.0 + 0.01,
         "a deviation beyond the largest shift"
     );
-    let tip_max = b[1600..].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let tip = largest(&b[1600..]);
     assert!(
-        tip_max > 0.95,
-        "the tip profile's largest deviation is {tip_max} mm"
+        tip > 0.95,
+        "the tip profile's largest deviation is {tip} mm"
     );
-    let root_max = b[..400].iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let root = largest(&b[..400]);
     assert!(
-        root_max > 0.38 && root_max < 0.41,
-        "the root profile's largest deviation is {root_max} mm"
+        root > 0.38 && root < 0.41,
+        "the root profile's largest deviation is {root} mm"
     );
 }
 
@@ -198,32 +182,14 @@ fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
     ellipsoid_csv(&master, 1500, 0.0);
     ellipsoid_csv(&part, 500, 0.25);
     let model = dir.path().join("surface.json");
-    let fit = zeroset_ok(&[
-        "fit",
-        "ip",
-        "--points",
-        master.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let (fit, saved) = fit_ip(master.to_str().unwrap(), &[], &model);
     assert!(fit.contains("(surface) to 1500 points"), "{fit}");
-    let saved: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(saved["model"]["kind"], "ip-surface");
-    let out = dir.path().join("deviations.csv");
-    zeroset_ok(&[
-        "deviate",
-        "--model",
-        model.to_str().unwrap(),
-        "--points",
+    let values = exact_deviations(
+        &model,
         part.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let values: Vec<f64> = deviations(&out)
-        .into_iter()
-        .map(|d| d.expect("every exact distance"))
-        .collect();
+        &dir.path().join("deviations.csv"),
+    );
     assert!(
         values.iter().all(|d| (d - 0.25).abs() < 0.001),
         "an offset of 0.25 mm everywhere: {:?}",

@@ -62,3 +62,44 @@ pub fn deviations(path: &Path) -> Vec<Option<f64>> {
 pub fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len() as f64
 }
+
+/// Runs `zeroset deviate` with the exact distance unless `distance` names another, and returns the deviation_mm
+/// column it wrote (None where a point has no deviation) with what it printed.
+pub fn deviate(
+    model: &Path,
+    points: &str,
+    distance: Option<&str>,
+    out: &Path,
+) -> (Vec<Option<f64>>, String) {
+    let mut args = vec![
+        "deviate",
+        "--model",
+        model.to_str().unwrap(),
+        "--points",
+        points,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    if let Some(method) = distance {
+        args.extend(["--distance", method]);
+    }
+    let printed = zeroset_ok(&args);
+    (deviations(out), printed)
+}
+
+/// Runs `zeroset fit ip` with the extra arguments and returns what it printed and the model file it wrote.
+pub fn fit_ip(points: &str, extra: &[&str], out: &Path) -> (String, serde_json::Value) {
+    let mut args = vec![
+        "fit",
+        "ip",
+        "--points",
+        points,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let printed = zeroset_ok(&args);
+    let saved =
+        serde_json::from_str(&std::fs::read_to_string(out).expect("the model file")).expect("JSON");
+    (printed, saved)
+}
