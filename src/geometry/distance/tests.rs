@@ -206,3 +206,28 @@ fn taubin_is_first_order_exact_near_the_curve() {
     let origin_gradient = taubin_distance(&model, &Vector2::new(0.0, 0.0));
     assert_eq!(origin_gradient, Err(DistanceError::ZeroGradient));
 }
+
+#[test]
+fn paper_plane_construction_in_3d_measures_a_sphere() {
+    // (|p|^2 - r^2) / 2r: a sphere of radius 30 mm. Points 0.5 mm outside and inside in general directions: the
+    // plane through the three axis intercepts (seed 003 section 4) gives the radial offset to second order.
+    use nalgebra::Vector3;
+    let r = 30.0;
+    let mut coeffs = vec![0.0; 10];
+    coeffs[0] = -r / 2.0;
+    for e in [[2u8, 0, 0], [0, 2, 0], [0, 0, 2]] {
+        let i = crate::geometry::poly::Basis::<3>::new(2).index_of(&e).unwrap();
+        coeffs[i] = 0.5 / r;
+    }
+    let sphere = IpModel { frame: Frame::identity(), poly: Poly::<3>::new(2, coeffs) };
+    for (direction, offset) in [
+        (Vector3::new(1.0, 2.0, 3.0), 0.5),
+        (Vector3::new(-2.0, 1.0, 1.5), -0.5),
+        (Vector3::new(0.3, -1.0, 0.8), 0.5),
+    ] {
+        let p = direction.normalize() * (r + offset);
+        let foot = paper_distance(&sphere, &p, 200.0).unwrap();
+        assert!((foot.distance - offset).abs() < offset * offset / r, "at {p}: {}", foot.distance);
+        assert!((foot.point.norm() - r).abs() < 1e-9, "the foot is on the sphere");
+    }
+}
