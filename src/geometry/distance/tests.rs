@@ -216,10 +216,15 @@ fn paper_plane_construction_in_3d_measures_a_sphere() {
     let mut coeffs = vec![0.0; 10];
     coeffs[0] = -r / 2.0;
     for e in [[2u8, 0, 0], [0, 2, 0], [0, 0, 2]] {
-        let i = crate::geometry::poly::Basis::<3>::new(2).index_of(&e).unwrap();
+        let i = crate::geometry::poly::Basis::<3>::new(2)
+            .index_of(&e)
+            .unwrap();
         coeffs[i] = 0.5 / r;
     }
-    let sphere = IpModel { frame: Frame::identity(), poly: Poly::<3>::new(2, coeffs) };
+    let sphere = IpModel {
+        frame: Frame::identity(),
+        poly: Poly::<3>::new(2, coeffs),
+    };
     for (direction, offset) in [
         (Vector3::new(1.0, 2.0, 3.0), 0.5),
         (Vector3::new(-2.0, 1.0, 1.5), -0.5),
@@ -227,7 +232,14 @@ fn paper_plane_construction_in_3d_measures_a_sphere() {
     ] {
         let p = direction.normalize() * (r + offset);
         let foot = paper_distance(&sphere, &p, 200.0).unwrap();
-        assert!((foot.distance - offset).abs() < offset * offset / r, "at {p}: {}", foot.distance);
-        assert!((foot.point.norm() - r).abs() < 1e-9, "the foot is on the sphere");
+        assert!(
+            (foot.distance - offset).abs() < offset * offset / r,
+            "at {p}: {}",
+            foot.distance
+        );
+        assert!(
+            (foot.point.norm() - r).abs() < 1e-9,
+            "the foot is on the sphere"
+        );
     }
 }
