@@ -1,0 +1,400 @@
+//! A propeller of N blades about the hub axis z, as in seed 003: blade A points along the part's +x axis,
+//! blade k is blade A turned k * 360/N degrees about z, and the profiles are the planar sections at constant
+//! radius (x = 100, 200, ... mm for blade A). In a section plane the coordinates are u (the tangential
+//! direction, +y for blade A) and v (+z, up the hub axis). Each section is a NACA 4-digit airfoil centred
+//! at mid-chord on the hub's mid-plane, its chord turned by the blade angle
+//! `atan(pitch / (2 pi r)) + twist(r)`, with chord and twist linear from root to tip.
+//!
+//! Each blade has its own manufacturing error, linear from root to tip: a shift along the hub axis (seed
+//! 003's blade B lies 0.4 mm below A at the root and 1.0 mm at the tip) and a twist about mid-chord. A
+//! shift rather than a normal offset keeps the section exact, and cannot pass through a sharp trailing
+//! edge as an inward offset larger than half its thickness would.
+
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point2, Point3, Vector3};
+use serde::Deserialize;
+
+use super::curve::{ClosedCurve, SampledCurve};
+use super::{parallel, prism_nearest, AnyCurve, Frame, Part, Plane, Pose, Section, SurfacePoint};
+use crate::naca::Naca4;
+
+/// The propeller as configured (`kind = "propeller"` in config/sims/*.toml).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropellerSpec {
+    pub blades: usize,
+    /// The hub: a cylinder about z, centred on the part's origin.
+    pub hub_radius_mm: f64,
+    pub hub_height_mm: f64,
+    /// The blades run from the root to the tip radius.
+    pub root_radius_mm: f64,
+    pub tip_radius_mm: f64,
+    /// Four digits, e.g. "4412".
+    pub naca: String,
+    pub sharp_trailing_edge: bool,
+    /// Chord at the root and at the tip.
+    pub chord_mm: [f64; 2],
+    /// Geometric pitch: the advance per turn that sets the blade angle atan(pitch / (2 pi r)).
+    pub pitch_mm: f64,
+    /// Designed twist added to the blade angle, at the root and at the tip.
+    pub twist_deg: [f64; 2],
+    /// One per blade, A first.
+    pub blade_errors: Vec<BladeError>,
+    pub pose: Pose,
+}
+
+/// A blade's manufacturing error, each value given at the root and at the tip.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BladeError {
+    /// Shift along the hub axis (+z up): blade B of seed 003 is [-0.4, -1.0].
+    pub shift_mm: [f64; 2],
+    /// Extra turn of the section about its mid-chord.
+    pub twist_deg: [f64; 2],
+}
+
+/// Why a propeller configuration cannot be built.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PropellerError {
+    #[error("naca = {0:?} is not four digits")]
+    BadNaca(String),
+    #[error("blade_errors has {found} entries; blades = {blades} needs one per blade")]
+    ErrorsPerBlade { found: usize, blades: usize },
+    #[error(
+        "need 0 < hub_radius_mm <= root_radius_mm < tip_radius_mm, positive chords and hub height"
+    )]
+    BadDimensions,
+}
+
+/// One blade section at a radius: the airfoil placed in its (u, v) plane.
+pub struct BladeSection {
+    foil: Naca4,
+    angle: f64,
+    shift: f64,
+}
+
+impl ClosedCurve for BladeSection {
+    fn point(&self, s: f64) -> Point2<f64> {
+        let [x, y] = self.foil.point(s.rem_euclid(1.0));
+        let x = x - self.foil.chord_mm / 2.0;
+        let (sin, cos) = self.angle.sin_cos();
+        Point2::new(x * cos - y * sin, x * sin + y * cos + self.shift)
+    }
+}
+
+/// The propeller, placed on the table.
+pub struct Propeller {
+    spec: PropellerSpec,
+    foil: Naca4,
+    pose: Isometry3<f64>,
+}
+
+impl Propeller {
+    pub fn new(spec: PropellerSpec) -> Result<Self, PropellerError> {
+        let foil = Naca4::from_digits(&spec.naca, 1.0, spec.sharp_trailing_edge)
+            .ok_or_else(|| PropellerError::BadNaca(spec.naca.clone()))?;
+        if spec.blade_errors.len() != spec.blades {
+            return Err(PropellerError::ErrorsPerBlade {
+                found: spec.blade_errors.len(),
+                blades: spec.blades,
+            });
+        }
+        let sane = spec.hub_radius_mm > 0.0
+            && spec.hub_radius_mm <= spec.root_radius_mm
+            && spec.root_radius_mm < spec.tip_radius_mm
+            && spec.chord_mm.iter().all(|c| *c > 0.0)
+            && spec.hub_height_mm > 0.0;
+        if !sane {
+            return Err(PropellerError::BadDimensions);
+        }
+        let pose = spec.pose.isometry();
+        Ok(Propeller { spec, foil, pose })
+    }
+
+    /// The blade's section at `radius` in its plane's (u, v) coordinates, with the blade's error.
+    pub fn section_curve(&self, blade: usize, radius: f64) -> BladeSection {
+        let error = &self.spec.blade_errors[blade];
+        let along = self.along(radius);
+        let angle = (self.spec.pitch_mm / (TAU * radius)).atan()
+            + along(self.spec.twist_deg).to_radians()
+            + along(error.twist_deg).to_radians();
+        BladeSection {
+            foil: Naca4 {
+                chord_mm: along(self.spec.chord_mm),
+                ..self.foil
+            },
+            angle,
+            shift: along(error.shift_mm),
+        }
+    }
+
+    /// The plane frame of the blade's section at `radius`, in machine coordinates: origin on the blade
+    /// axis at that radius, u tangential, v up the hub axis, w along the blade's radius.
+    pub fn section_frame(&self, blade: usize, radius: f64) -> Frame {
+        let angle = TAU * blade as f64 / self.spec.blades as f64;
+        let (sin, cos) = angle.sin_cos();
+        let radial = Vector3::new(cos, sin, 0.0);
+        let tangential = Vector3::new(-sin, cos, 0.0);
+        Frame::placed(
+            Point3::from(radial * radius),
+            tangential,
+            Vector3::z(),
+            &self.pose,
+        )
+    }
+
+    /// Linear interpolation of a [root, tip] pair at `radius`.
+    fn along(&self, radius: f64) -> impl Fn([f64; 2]) -> f64 {
+        let t = (radius - self.spec.root_radius_mm)
+            / (self.spec.tip_radius_mm - self.spec.root_radius_mm);
+        move |[root, tip]| root + (tip - root) * t
+    }
+
+    /// A blade's solid: its sections stacked along its radius from root to tip.
+    fn blade_nearest(&self, blade: usize, p: &Point3<f64>) -> SurfacePoint {
+        let axis = self.section_frame(blade, 0.0);
+        let range = (self.spec.root_radius_mm, self.spec.tip_radius_mm);
+        let radius = axis.local(p).z.clamp(range.0, range.1);
+        let section = SampledCurve::new(self.section_curve(blade, radius));
+        prism_nearest(&axis, range, &section, p)
+    }
+
+    /// A lower bound of the distance from `p` to the blade: the distance to a box about the blade that
+    /// holds every section (half the root chord covers any turn of the chord; the thickness and the shifts
+    /// are far smaller).
+    fn blade_bound(&self, blade: usize, p: &Point3<f64>) -> f64 {
+        let local = self.section_frame(blade, 0.0).local(p);
+        let half = self.spec.chord_mm[0].max(self.spec.chord_mm[1]) / 2.0 + 10.0;
+        let outside = |value: f64, lo: f64, hi: f64| (lo - value).max(value - hi).max(0.0);
+        Vector3::new(
+            outside(local.x, -half, half),
+            outside(local.y, -half, half),
+            outside(local.z, self.spec.root_radius_mm, self.spec.tip_radius_mm),
+        )
+        .norm()
+    }
+
+    /// The hub: a cylinder about z, exact distance.
+    fn hub_nearest(&self, p: &Point3<f64>) -> SurfacePoint {
+        let local = self.pose.inverse() * p;
+        let (radius, half) = (self.spec.hub_radius_mm, self.spec.hub_height_mm / 2.0);
+        let rho = local.xy().coords.norm();
+        let radial = if rho > 1e-12 {
+            Vector3::new(local.x / rho, local.y / rho, 0.0)
+        } else {
+            Vector3::x()
+        };
+        let side_out = rho - radius;
+        let cap_out = local.z.abs() - half;
+        let up = Vector3::z() * local.z.signum();
+        let (point, normal, distance) = if side_out > 0.0 && cap_out > 0.0 {
+            let rim = Point3::from(radial * radius + up * half);
+            let distance = (local - rim).norm();
+            (rim, (local - rim) / distance, distance)
+        } else if side_out > cap_out {
+            let on_side = Point3::new(radial.x * radius, radial.y * radius, local.z);
+            (on_side, radial, side_out)
+        } else {
+            (
+                Point3::new(local.x, local.y, half * local.z.signum()),
+                up,
+                cap_out,
+            )
+        };
+        SurfacePoint {
+            point: self.pose * point,
+            normal: self.pose * normal,
+            signed_distance: distance,
+        }
+    }
+}
+
+impl Part for Propeller {
+    /// The union of hub and blades: the nearest of them (exact outside the material, which is where the
+    /// probe is).
+    fn nearest(&self, p: &Point3<f64>) -> SurfacePoint {
+        let mut best = self.hub_nearest(p);
+        for blade in 0..self.spec.blades {
+            if self.blade_bound(blade, p) >= best.signed_distance {
+                continue;
+            }
+            let candidate = self.blade_nearest(blade, p);
+            if candidate.signed_distance < best.signed_distance {
+                best = candidate;
+            }
+        }
+        best
+    }
+
+    fn section(&self, plane: &Plane) -> Option<Section> {
+        (0..self.spec.blades).find_map(|blade| {
+            let axis = self.section_frame(blade, 0.0);
+            let radius = axis.local(&plane.point).z;
+            let cuts = parallel(&plane.normal, &axis.w)
+                && (self.spec.root_radius_mm..=self.spec.tip_radius_mm).contains(&radius);
+            cuts.then(|| Section {
+                frame: axis.shifted(radius),
+                curve: Arc::new(SampledCurve::new(
+                    Box::new(self.section_curve(blade, radius)) as AnyCurve,
+                )),
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec() -> PropellerSpec {
+        let exact = BladeError {
+            shift_mm: [0.0, 0.0],
+            twist_deg: [0.0, 0.0],
+        };
+        PropellerSpec {
+            blades: 3,
+            hub_radius_mm: 50.0,
+            hub_height_mm: 120.0,
+            root_radius_mm: 60.0,
+            tip_radius_mm: 560.0,
+            naca: "4412".into(),
+            sharp_trailing_edge: true,
+            chord_mm: [180.0, 90.0],
+            pitch_mm: 900.0,
+            twist_deg: [0.0, 0.0],
+            blade_errors: vec![
+                exact,
+                BladeError {
+                    shift_mm: [-0.4, -1.0],
+                    ..exact
+                },
+                BladeError {
+                    shift_mm: [0.4, 1.0],
+                    ..exact
+                },
+            ],
+            pose: Pose {
+                x_mm: 0.0,
+                y_mm: 0.0,
+                z_mm: 0.0,
+                rot_z_deg: 0.0,
+            },
+        }
+    }
+
+    #[test]
+    fn blade_b_lies_below_a_by_its_error_and_c_above() {
+        let propeller = Propeller::new(spec()).unwrap();
+        for (radius, expected) in [(60.0, 0.4), (310.0, 0.7), (560.0, 1.0)] {
+            let a = propeller.section_curve(0, radius);
+            let b = propeller.section_curve(1, radius);
+            let c = propeller.section_curve(2, radius);
+            for s in [0.1, 0.3, 0.5, 0.8] {
+                let (pa, pb, pc) = (a.point(s), b.point(s), c.point(s));
+                assert!((pa.x - pb.x).abs() < 1e-12 && (pa.x - pc.x).abs() < 1e-12);
+                assert!((pa.y - pb.y - expected).abs() < 1e-9, "B at r={radius}");
+                assert!((pc.y - pa.y - expected).abs() < 1e-9, "C at r={radius}");
+            }
+        }
+    }
+
+    #[test]
+    fn sections_of_blade_a_lie_in_planes_of_constant_x() {
+        let propeller = Propeller::new(spec()).unwrap();
+        let frame = propeller.section_frame(0, 200.0);
+        let curve = propeller.section_curve(0, 200.0);
+        let p = curve.point(0.25);
+        let world = frame.world(p.x, p.y, 0.0);
+        assert!((world.x - 200.0).abs() < 1e-12);
+        assert!((world.y - p.x).abs() < 1e-12 && (world.z - p.y).abs() < 1e-12);
+        // Blade B is blade A turned 120 degrees about z.
+        let b = propeller.section_frame(1, 200.0);
+        assert!((b.origin - Point3::new(-100.0, 200.0 * 0.75f64.sqrt(), 0.0)).norm() < 1e-9);
+    }
+
+    #[test]
+    fn surface_points_and_normals_are_consistent() {
+        let propeller = Propeller::new(spec()).unwrap();
+        let frame = propeller.section_frame(0, 300.0);
+        let curve = SampledCurve::new(propeller.section_curve(0, 300.0));
+        for s in [0.05, 0.2, 0.45, 0.6, 0.9] {
+            let on = curve.at(s);
+            let surface = frame.world(on.point.x, on.point.y, 0.0);
+            let outward = frame.world_dir(on.normal.x, on.normal.y, 0.0);
+            let probe = surface + outward * 3.0;
+            let nearest = propeller.nearest(&probe);
+            assert!(
+                (nearest.signed_distance - 3.0).abs() < 1e-6,
+                "s={s}: {}",
+                nearest.signed_distance
+            );
+            assert!((nearest.point - surface).norm() < 1e-5);
+            let inside = propeller.nearest(&(surface - outward * 0.5));
+            assert!(inside.signed_distance < 0.0);
+        }
+    }
+
+    #[test]
+    fn the_hub_is_material_and_far_points_are_outside() {
+        let propeller = Propeller::new(spec()).unwrap();
+        let hub = propeller.nearest(&Point3::new(0.0, 0.0, 70.0));
+        assert!((hub.signed_distance - 10.0).abs() < 1e-9);
+        assert_eq!(hub.normal, Vector3::z());
+        assert!(
+            propeller
+                .nearest(&Point3::new(0.0, 0.0, 0.0))
+                .signed_distance
+                < 0.0
+        );
+        assert!(
+            propeller
+                .nearest(&Point3::new(0.0, 0.0, 400.0))
+                .signed_distance
+                > 300.0
+        );
+    }
+
+    #[test]
+    fn only_planes_across_a_blade_have_sections() {
+        let propeller = Propeller::new(spec()).unwrap();
+        let across_a = Plane {
+            point: Point3::new(200.0, 5.0, 3.0),
+            normal: -Vector3::x(),
+        };
+        let section = propeller
+            .section(&across_a)
+            .expect("plane x = 200 cuts blade A");
+        assert!((section.frame.origin - Point3::new(200.0, 0.0, 0.0)).norm() < 1e-9);
+        let beyond_tip = Plane {
+            point: Point3::new(600.0, 0.0, 0.0),
+            normal: Vector3::x(),
+        };
+        assert!(propeller.section(&beyond_tip).is_none());
+        let slanted = Plane {
+            point: Point3::new(200.0, 0.0, 0.0),
+            normal: Vector3::new(1.0, 1.0, 0.0),
+        };
+        assert!(propeller.section(&slanted).is_none());
+    }
+
+    #[test]
+    fn bad_configurations_are_refused() {
+        let mut two_errors = spec();
+        two_errors.blade_errors.pop();
+        assert_eq!(
+            Propeller::new(two_errors).err(),
+            Some(PropellerError::ErrorsPerBlade {
+                found: 2,
+                blades: 3
+            })
+        );
+        let mut bad_naca = spec();
+        bad_naca.naca = "44123".into();
+        assert!(matches!(
+            Propeller::new(bad_naca),
+            Err(PropellerError::BadNaca(_))
+        ));
+    }
+}

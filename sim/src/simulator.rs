@@ -1,0 +1,132 @@
+//! The whole simulator: opens every configured machine's line, prints `machine NAME PATH` for each, then
+//! serves them (one task per machine) until SIGINT, SIGTERM or the end of standard input. Standard input
+//! is also the fault channel: `fault MACHINE KIND [ARG]` per line (see faults.rs), answered on standard
+//! output with `ok fault MACHINE KIND` or `error: WHY`.
+
+use std::collections::HashMap;
+use std::io::{self, Write};
+
+use tokio::io::{AsyncBufReadExt, BufReader};
+use tokio::signal::unix::{signal, SignalKind};
+use tokio::sync::{mpsc, watch};
+
+use crate::config::{PortKind, SimConfig};
+use crate::faults::FaultRequest;
+use crate::link::Link;
+use crate::machine::{Clock, Machine};
+use crate::protocol::Controller;
+use crate::transcript::Transcript;
+
+/// Why the simulator could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("machine {machine}: {what}: {source}")]
+    Machine {
+        machine: String,
+        what: &'static str,
+        source: io::Error,
+    },
+    #[error("{0}")]
+    Io(#[from] io::Error),
+    #[error("{0}")]
+    Part(String),
+}
+
+/// Runs the configured machines; `time_scale` overrides the file's.
+pub async fn run(config: SimConfig, time_scale: Option<f64>) -> Result<(), RunError> {
+    let clock = Clock::new(time_scale.unwrap_or(config.time_scale));
+    let (stop, shutdown) = watch::channel(false);
+    let mut senders = HashMap::new();
+    let mut tasks = Vec::new();
+    let mut announce = String::new();
+    for machine in &config.machines {
+        let failed = |what| {
+            let machine = machine.name.clone();
+            move |source| RunError::Machine {
+                machine,
+                what,
+                source,
+            }
+        };
+        let part = config.parts[&machine.part]
+            .build()
+            .map_err(RunError::Part)?;
+        let link = match machine.port {
+            PortKind::Pty => Link::pty().map_err(failed("opening a pseudo-terminal"))?,
+            PortKind::Tcp => Link::tcp(machine.tcp_port.unwrap_or(0))
+                .await
+                .map_err(failed("listening on 127.0.0.1"))?,
+        };
+        let transcript_path = machine
+            .transcript
+            .clone()
+            .unwrap_or_else(|| Transcript::default_path(&machine.name));
+        let transcript =
+            Transcript::create(&transcript_path).map_err(failed("creating the transcript"))?;
+        announce.push_str(&format!(
+            "machine {} {}\n",
+            machine.name,
+            link.address().map_err(failed("reading the address"))?
+        ));
+        let (faults_in, faults) = mpsc::channel(16);
+        senders.insert(machine.name.clone(), faults_in);
+        let task = Machine {
+            name: machine.name.clone(),
+            controller: Controller::new(machine, part),
+            link,
+            transcript,
+            clock,
+            baud: machine.baud,
+            scheduled: machine.faults.clone(),
+            faults,
+        };
+        tasks.push(tokio::spawn(task.serve(shutdown.clone())));
+    }
+    // Handlers first: a client may signal as soon as it has read the announcement.
+    let mut terminate = signal(SignalKind::terminate())?;
+    let mut interrupt = signal(SignalKind::interrupt())?;
+    print_flushed(&announce)?;
+
+    let mut stdin = BufReader::new(tokio::io::stdin()).lines();
+    loop {
+        tokio::select! {
+            _ = terminate.recv() => break,
+            _ = interrupt.recv() => break,
+            line = stdin.next_line() => {
+                let Some(line) = line? else { break };
+                if line.trim().is_empty() {
+                    continue;
+                }
+                let reply = match FaultRequest::parse(&line) {
+                    Ok(request) => match senders.get(&request.machine) {
+                        Some(sender) => match sender.send(request.fault).await {
+                            Ok(()) => format!("ok {}\n", line.trim()),
+                            Err(_) => format!("error: machine {} has stopped\n", request.machine),
+                        },
+                        None => format!("error: no machine named {:?}\n", request.machine),
+                    },
+                    Err(problem) => format!("error: {problem}\n"),
+                };
+                print_flushed(&reply)?;
+            }
+        }
+    }
+    // Receivers may be gone already if a task failed; its error is reported below.
+    let _ = stop.send(true);
+    for (task, machine) in tasks.into_iter().zip(&config.machines) {
+        task.await
+            .map_err(|e| RunError::Io(io::Error::other(e)))?
+            .map_err(|source| RunError::Machine {
+                machine: machine.name.clone(),
+                what: "serving",
+                source,
+            })?;
+    }
+    Ok(())
+}
+
+fn print_flushed(text: &str) -> io::Result<()> {
+    let mut out = io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()
+}
