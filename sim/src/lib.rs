@@ -6,6 +6,7 @@
 //! [`link::Link`], measuring a [`part::Part`] with a [`probe`] under [`kinematics`] limits, with
 //! [`faults`] on demand and a [`transcript`].
 
+pub mod cli;
 pub mod config;
 pub mod faults;
 pub mod kinematics;

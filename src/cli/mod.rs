@@ -27,6 +27,8 @@ enum Command {
     Fit(FitCommand),
     /// Signed deviations (mm, positive outside the material) of measured points from a reference model.
     Deviate(deviate::DeviateArgs),
+    /// Run the simulated CMMs of a simulator configuration (the same as the zeroset-sim binary).
+    Sim(zeroset_sim::cli::SimArgs),
 }
 
 #[derive(Subcommand)]
@@ -82,6 +84,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
         Command::Deviate(args) => deviate::run(&args),
+        Command::Sim(args) => zeroset_sim::cli::run(&args),
     }
 }
 

@@ -1,0 +1,40 @@
+//! The simulator's command line, shared by the `zeroset-sim` binary and `zeroset sim`.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+
+use crate::config::SimConfig;
+
+/// Simulated coordinate measuring machines speaking I++ DME on pseudo-terminals or loopback TCP.
+///
+/// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT, SIGTERM or the end of standard
+/// input. Lines `fault MACHINE KIND [ARG]` on standard input inject faults: garbage, drop-lines N, delay MS,
+/// disconnect MS, estop, collision, no-touch, surface-not-found.
+#[derive(Debug, Args)]
+pub struct SimArgs {
+    /// The simulator's configuration, e.g. config/sims/propeller.toml.
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Machine seconds per wall-clock second, overriding the file's time_scale (100 = 100x faster).
+    #[arg(long)]
+    pub time_scale: Option<f64>,
+}
+
+/// Loads the configuration and serves its machines until stopped.
+pub fn run(args: &SimArgs) -> anyhow::Result<()> {
+    let config = SimConfig::load(&args.config)?;
+    if let Some(scale) = args.time_scale {
+        anyhow::ensure!(
+            scale > 0.0 && scale.is_finite(),
+            "--time-scale {scale} must be above zero"
+        );
+    }
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
+    runtime.block_on(crate::simulator::run(config, args.time_scale))?;
+    Ok(())
+}

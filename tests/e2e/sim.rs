@@ -1,0 +1,114 @@
+//! A running simulator (`zeroset sim`, the real binary) and the station's I++ client on its pseudo-terminals.
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::time::Duration;
+
+use zeroset_drivers::client::{Client, ClientConfig};
+use zeroset_drivers::transport::open_pty;
+use zeroset_sim::config::{PartSpec, SimConfig};
+use zeroset_sim::part::propeller::Propeller;
+
+use crate::support::{config, repo};
+
+/// The simulator runs this many times faster than real time in the tests.
+pub const TIME_SCALE: f64 = 100.0;
+
+/// A simulator process, killed when dropped.
+pub struct Sim {
+    child: Child,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+    machines: Vec<(String, String)>,
+}
+
+impl Sim {
+    /// Starts `zeroset sim` with a configuration from config/sims/ and waits for its `machine NAME PATH` lines.
+    pub fn start(name: &str) -> Sim {
+        let path = config(&format!("sims/{name}"));
+        let expected = SimConfig::load(path.as_ref())
+            .expect("the config loads")
+            .machines
+            .len();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+            .args([
+                "sim",
+                "--config",
+                &path,
+                "--time-scale",
+                &TIME_SCALE.to_string(),
+            ])
+            .current_dir(repo())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("zeroset sim starts");
+        let stdin = child.stdin.take().expect("piped");
+        let mut stdout = BufReader::new(child.stdout.take().expect("piped"));
+        let machines = (0..expected)
+            .map(|_| {
+                let mut line = String::new();
+                stdout.read_line(&mut line).expect("a line");
+                let words: Vec<&str> = line.split_whitespace().collect();
+                assert!(
+                    words.len() == 3 && words[0] == "machine",
+                    "unexpected: {line:?}"
+                );
+                (words[1].to_string(), words[2].to_string())
+            })
+            .collect();
+        Sim {
+            child,
+            stdin,
+            stdout,
+            machines,
+        }
+    }
+
+    pub fn path(&self, machine: &str) -> &str {
+        &self
+            .machines
+            .iter()
+            .find(|(name, _)| name == machine)
+            .expect("a configured machine")
+            .1
+    }
+
+    /// Sends a control line (e.g. `fault cmm1 estop`) and returns the simulator's answer.
+    pub fn control(&mut self, line: &str) -> String {
+        writeln!(self.stdin, "{line}").expect("the simulator reads its stdin");
+        let mut answer = String::new();
+        self.stdout.read_line(&mut answer).expect("an answer");
+        answer.trim().to_string()
+    }
+
+    /// The station's client on a machine's pseudo-terminal.
+    pub fn client(&self, machine: &str, config: ClientConfig) -> Client {
+        let port = open_pty(self.path(machine)).expect("the pty opens");
+        Client::new(machine, port, config)
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Timeouts short enough for tests, long enough for the simulator at TIME_SCALE.
+pub fn quick() -> ClientConfig {
+    ClientConfig {
+        ack_timeout: Duration::from_secs(2),
+        reply_timeout: Duration::from_secs(10),
+    }
+}
+
+/// The simulator's own analytic propeller, for checking what the probe reported.
+pub fn propeller() -> Propeller {
+    let loaded = SimConfig::load(config("sims/propeller.toml").as_ref()).expect("the config loads");
+    let PartSpec::Propeller(spec) = &loaded.parts["propeller"] else {
+        panic!("propeller.toml holds a propeller");
+    };
+    Propeller::new(spec.clone()).expect("a valid propeller")
+}
