@@ -35,6 +35,10 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    runtime.block_on(crate::simulator::run(config, args.time_scale))?;
+    let served = runtime.block_on(crate::simulator::run(config, args.time_scale));
+    // Standard input is read on a blocking thread that no signal interrupts: waiting for it (what dropping the
+    // runtime does) would keep a simulator told to stop by SIGTERM alive until its stdin closes.
+    runtime.shutdown_background();
+    served?;
     Ok(())
 }

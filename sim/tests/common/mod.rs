@@ -3,6 +3,9 @@
 
 #![allow(dead_code)] // each test file uses its own share of these helpers
 
+pub mod nist;
+pub mod shape;
+
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
