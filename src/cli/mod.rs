@@ -28,6 +28,10 @@ enum Command {
     /// Signed deviations (mm, positive outside the material) of measured points from a reference model.
     Deviate(deviate::DeviateArgs),
     /// Run the simulated CMMs of a simulator configuration (the same as the zeroset-sim binary).
+    ///
+    /// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT, SIGTERM or the end of
+    /// standard input. Lines `fault MACHINE KIND [ARG]` on standard input inject faults: garbage, drop-lines N,
+    /// delay MS, disconnect MS, estop, collision, no-touch, surface-not-found.
     Sim(zeroset_sim::cli::SimArgs),
 }
 

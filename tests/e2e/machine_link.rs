@@ -242,8 +242,9 @@ async fn each_fault_reports_its_own_error() {
         .await
         .expect("the link goes on after a timeout");
 
-    // A late reply beyond the acknowledge timeout is a timeout too.
-    assert!(sim.control("fault cmm1 delay 2500").starts_with("ok"));
+    // A late reply beyond the acknowledge timeout is a timeout too (the delay is wall-clock time, past the
+    // 5 s acknowledge timeout of `quick`).
+    assert!(sim.control("fault cmm1 delay 6000").starts_with("ok"));
     let late = client
         .is_homed()
         .await
@@ -252,7 +253,7 @@ async fn each_fault_reports_its_own_error() {
         matches!(late.transport_error(), Some(TransportError::Timeout { .. })),
         "{late}"
     );
-    tokio::time::sleep(Duration::from_millis(700)).await;
+    tokio::time::sleep(Duration::from_millis(1500)).await;
     client
         .clear_all_errors()
         .await

@@ -62,9 +62,15 @@ fn the_readme_example_runs_and_finds_blade_b_0_8_mm_inside() {
 #[test]
 fn help_describes_every_command_with_units() {
     let top = zeroset_ok(&["--help"]);
-    assert!(top.contains("fit") && top.contains("deviate") && top.contains("sim"), "{top}");
+    assert!(
+        top.contains("fit") && top.contains("deviate") && top.contains("sim"),
+        "{top}"
+    );
     let sim = zeroset_ok(&["sim", "--help"]);
-    assert!(sim.contains("--config") && sim.contains("--time-scale") && sim.contains("fault"), "{sim}");
+    assert!(
+        sim.contains("--config") && sim.contains("--time-scale") && sim.contains("fault"),
+        "{sim}"
+    );
     let fit = zeroset_ok(&["fit", "ip", "--help"]);
     for option in [
         "--points",

@@ -99,7 +99,7 @@ impl Drop for Sim {
 /// Timeouts short enough for tests, long enough for the simulator at TIME_SCALE.
 pub fn quick() -> ClientConfig {
     ClientConfig {
-        ack_timeout: Duration::from_secs(2),
+        ack_timeout: Duration::from_secs(5),
         reply_timeout: Duration::from_secs(10),
     }
 }
