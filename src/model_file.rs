@@ -55,6 +55,30 @@ pub struct FittedIp<const N: usize> {
     pub fit: Option<FitStats>,
 }
 
+impl<const N: usize> FittedIp<N> {
+    /// What a model file must satisfy to be evaluated as it was saved: a positive, finite scale, a polynomial
+    /// that is not identically zero, and a domain whose corners are finite and ordered.
+    fn check(&self) -> Result<(), String> {
+        let scale = self.ip.frame.scale;
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(format!(
+                "ip.frame.scale is {scale}; it must be a positive number of mm"
+            ));
+        }
+        if self.ip.frame.center.iter().any(|c| !c.is_finite()) {
+            return Err("ip.frame.center has a value that is not a finite number".to_string());
+        }
+        if self.ip.poly.coeffs().iter().all(|c| *c == 0.0) {
+            return Err("ip.poly.coefficients are all zero: the model has no zero set".to_string());
+        }
+        let ordered = (0..N).all(|k| self.domain.min[k] < self.domain.max[k]);
+        if !ordered {
+            return Err("domain.min must be below domain.max on every axis".to_string());
+        }
+        Ok(())
+    }
+}
+
 /// One profile of a stack: its position along x (mm) and its fitted (y, z) model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -108,9 +132,20 @@ impl ModelFile {
                 format!("units '{}' (only mm are supported)", file.units),
             ));
         }
-        if let ReferenceModel::Stack { profiles } = &file.model {
-            stack_of(profiles).map_err(|e| ModelFileError::new(path, e.to_string()))?;
-        }
+        let checked = match &file.model {
+            ReferenceModel::Profile(m) => m.check(),
+            ReferenceModel::Surface(m) => m.check(),
+            ReferenceModel::Stack { profiles } => profiles
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, p)| {
+                    p.fitted
+                        .check()
+                        .map_err(|e| format!("profile {i} (x = {} mm): {e}", p.x))
+                })
+                .and_then(|()| stack_of(profiles).map(drop).map_err(|e| e.to_string())),
+        };
+        checked.map_err(|problem| ModelFileError::new(path, problem))?;
         Ok(file)
     }
 }

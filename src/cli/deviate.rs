@@ -62,7 +62,10 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
             (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
                 let stack =
                     stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
-                let domains: Vec<Aabb<2>> = profiles.iter().map(|p| p.fitted.domain).collect();
+                // The stack sorts its profiles along x; pair each with its own domain in that order.
+                let mut sorted = profiles.clone();
+                sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
+                let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
                 let reach = 4.0 * stack.bounds(&domains).diagonal();
                 let distances = match method {
                     DistanceMethod::Exact => {
@@ -97,6 +100,14 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     };
     write_csv(&args.out, header, &rows, &distances)?;
     print_summary(&args.points, &file, method, &distances);
+    if distances.iter().all(Result::is_err) {
+        anyhow::bail!(
+            "{}: no point has a deviation from {} (see the status column of {})",
+            args.points.display(),
+            args.model.display(),
+            args.out.display()
+        );
+    }
     println!(
         "wrote {} ({:.2} s)",
         args.out.display(),
@@ -174,9 +185,12 @@ fn print_summary(
         );
     }
     if failed > 0 {
-        println!(
-            "  {failed} point(s) without a deviation: see the status column (the paper's approximation fails near \
-             edges; use --distance exact)"
-        );
+        let hint = match method {
+            DistanceMethod::Paper => {
+                "the paper's approximation fails near edges; --distance exact always answers"
+            }
+            _ => "outside the model's range, or where the model has no zero set nearby",
+        };
+        println!("  {failed} point(s) without a deviation, see the status column ({hint})");
     }
 }

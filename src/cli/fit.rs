@@ -245,6 +245,13 @@ fn print_fit<const N: usize>(path: &Path, what: &str, fitted: &Fitted<N>) {
             s.zero_set_components
         );
     }
+    if s.inverted_side_probes > 0 {
+        println!(
+            "  warning: the model puts {} of {} points just inside or outside the data on the wrong side: \
+             deviations measured near them may have the wrong sign",
+            s.inverted_side_probes, s.side_probes
+        );
+    }
     if s.points_without_foot > 0 {
         println!(
             "  warning: {} fitted points have no foot point on the model",

@@ -32,6 +32,10 @@ const OFFSET_CANDIDATES: [f64; 4] = [0.003, 0.01, 0.03, 0.1];
 /// The largest offsets of the ridge fits that start the orthogonal refinement: the refinement finds a local
 /// minimum, and on airfoil sections one of these two starts was the better in every case measured.
 const ORTHOGONAL_START_OFFSETS: [f64; 2] = [0.1, 0.03];
+/// Side probes reach at most this far (a fraction of the RMS radius) and are only used from this depth on: the
+/// probe noise of a CMM (microns) stays well below it on parts of tens of millimetres.
+const PROBE_REACH: f64 = 0.1;
+const PROBE_MIN_DEPTH: f64 = 2e-3;
 /// An offset point must be at least this fraction of its offset away from every other data point.
 const OFFSET_CLEARANCE: f64 = 0.98;
 const OFFSET_HALVINGS: usize = 12;
@@ -111,6 +115,12 @@ pub struct FitStats {
     pub refinement_iterations: usize,
     /// Points whose exact distance could not be computed (a defect of the model near them).
     pub points_without_foot: usize,
+    /// Points just inside and outside the data whose side is known, and how many of them the model puts on the
+    /// wrong side (any means deviations near them may have the wrong sign).
+    #[serde(default)]
+    pub side_probes: usize,
+    #[serde(default)]
+    pub inverted_side_probes: usize,
 }
 
 impl FitStats {
@@ -188,6 +198,7 @@ pub fn fit_ip<const N: usize>(
         (None, FitMethod::Orthogonal) => ORTHOGONAL_START_OFFSETS.to_vec(),
         (None, FitMethod::ThreeL | FitMethod::Ridge) => OFFSET_CANDIDATES.to_vec(),
     };
+    let probes = SideProbes::new(&unit, normals);
     let mut best: Option<Fitted<N>> = None;
     for largest_offset in candidates {
         let offsets = choose_offsets(&unit, normals, largest_offset);
@@ -202,7 +213,13 @@ pub fn fit_ip<const N: usize>(
         let mut poly = Poly::new(degree, coeffs);
         let mut refinement_iterations = 0;
         if options.method == FitMethod::Orthogonal {
-            if let Some((refined, iterations)) = refine_orthogonal(&poly, &unit) {
+            // Unconstrained first: the most accurate, unless it puts more side probes on the wrong side than
+            // its start does; then the refinement that may not.
+            let allowed = probes.inverted(&poly);
+            let refined = refine_orthogonal(&poly, &unit, None)
+                .filter(|(r, _)| probes.inverted(r) <= allowed)
+                .or_else(|| refine_orthogonal(&poly, &unit, Some(&probes)));
+            if let Some((refined, iterations)) = refined {
                 poly = refined;
                 refinement_iterations = iterations;
             }
@@ -225,6 +242,8 @@ pub fn fit_ip<const N: usize>(
         stats.offset_min_mm = min_offset * frame.scale;
         stats.offset_max_mm = max_offset * frame.scale;
         stats.refinement_iterations = refinement_iterations;
+        stats.side_probes = probes.len();
+        stats.inverted_side_probes = probes.inverted(&model.poly);
         let candidate = Fitted {
             model,
             method: options.method,
@@ -251,7 +270,9 @@ fn check_spread<const N: usize>(points: &[SVector<f64, N>]) -> Result<(), FitErr
     let eigen = small::symmetric_eigen(&covariance);
     let smallest = eigen[0].0;
     let largest = eigen[N - 1].0;
-    if largest <= 0.0 || smallest <= largest * 1e-18 {
+    // A spread thinner than 1e-5 of the length (0.1 um across 10 mm) is a line or plane measured with noise:
+    // inside and outside would mean nothing for a model of it.
+    if largest <= 0.0 || smallest <= largest * 1e-10 {
         let what = match N {
             2 => "straight line",
             _ => "plane",
@@ -292,6 +313,47 @@ fn choose_offsets<const N: usize>(
             outside: safe(i, 1.0),
         })
         .collect()
+}
+
+/// Points whose side of the surface the data prove: along each point's normal, inside and outside, at half the
+/// deepest offset that stays nearer its own point than any other (so never past the middle of a thin section),
+/// where that is deep enough for the model to be expected to follow (not the last microns of a sharp edge,
+/// which no single polynomial follows). A model whose sign is wrong at one of them would report a deviation there with the wrong
+/// sign; fitting distances alone can grow such a sliver of zero set inside a trailing edge.
+pub(crate) struct SideProbes<const N: usize> {
+    /// Each probe and the sign F must have there (-1 inside, +1 outside).
+    probes: Vec<(SVector<f64, N>, f64)>,
+}
+
+impl<const N: usize> SideProbes<N> {
+    fn new(unit: &[SVector<f64, N>], normals: &[SVector<f64, N>]) -> Self {
+        let mut probes = Vec::with_capacity(4 * unit.len());
+        for ((u, n), o) in unit
+            .iter()
+            .zip(normals)
+            .zip(choose_offsets(unit, normals, PROBE_REACH))
+        {
+            for (depth, side) in [(o.inside, -1.0), (o.outside, 1.0)] {
+                // Probes shallower than this could sit on the wrong side through the probe noise alone.
+                if let Some(depth) = depth.filter(|d| *d >= PROBE_MIN_DEPTH) {
+                    probes.push((u + n * (side * 0.5 * depth), side));
+                }
+            }
+        }
+        Self { probes }
+    }
+
+    /// How many probes the polynomial (in normalised coordinates) puts on the wrong side.
+    fn inverted(&self, poly: &Poly<N>) -> usize {
+        self.probes
+            .iter()
+            .filter(|(p, side)| poly.value(p) * side <= 0.0)
+            .count()
+    }
+
+    fn len(&self) -> usize {
+        self.probes.len()
+    }
 }
 
 /// Ridge penalty per coefficient: kappa * rows * beta_|e| * (prod e_k!) / |e|!, with beta_k the mean of |u|^(2k)
@@ -409,11 +471,20 @@ fn feet_of<const N: usize>(
 /// No ridge term and no constraint on the zero set away from the data: a ridge weight is relative to algebraic
 /// residuals and would dominate distances of a few microns, and forbidding new zero-set components blocks the
 /// optimum even for the paper's own published quartic, which has a second branch inside twice its data's box.
-/// Spurious branches are therefore reported in the fit statistics (zero_set_components), not hidden.
+/// Spurious branches are therefore reported in the fit statistics (zero_set_components), not hidden. What is
+/// constrained, when `probes` are given, is the side: no step may put more side probes on the wrong side than the
+/// start does, since a sliver of zero set inside a thin edge would flip the sign of every deviation there.
 fn refine_orthogonal<const N: usize>(
     start: &Poly<N>,
     unit: &[SVector<f64, N>],
+    probes: Option<&SideProbes<N>>,
 ) -> Option<(Poly<N>, usize)> {
+    // With probes, a step may not put more of them on the wrong side than the start does.
+    let allowed_inverted = probes.map(|p| p.inverted(start));
+    let keeps_sides = |candidate: &Poly<N>| match (probes, allowed_inverted) {
+        (Some(p), Some(allowed)) => p.inverted(candidate) <= allowed,
+        _ => true,
+    };
     let projected: Vec<SVector<f64, N>> = unit
         .iter()
         .map(|u| project_to_zero_set(start, u, 0.5))
@@ -461,7 +532,7 @@ fn refine_orthogonal<const N: usize>(
                 normalise_gradient(Poly::new(poly.degree(), candidate_coeffs), &feet.points);
             if let Some(candidate_feet) = feet_of(&candidate, unit, &feet.points) {
                 let value = sum_of_squares(&candidate_feet);
-                if value < current {
+                if value < current && keeps_sides(&candidate) {
                     let improvement = (current - value) / current;
                     poly = candidate;
                     feet = candidate_feet;
@@ -533,6 +604,8 @@ fn measure<const N: usize>(
         offset_max_mm: 0.0,
         refinement_iterations: 0,
         points_without_foot: failed,
+        side_probes: 0,
+        inverted_side_probes: 0,
     }
 }
 

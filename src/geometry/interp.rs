@@ -13,7 +13,7 @@ use nalgebra::{SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::implicit::{Frame, Implicit, IpModel};
-use super::poly::Poly;
+use super::poly::{Poly, MAX_DEGREE};
 use super::sampling::Aabb;
 
 /// One measured profile: its model in the (y, z) plane at position `x` along the profile axis.
@@ -33,6 +33,8 @@ pub enum StackError {
     SamePosition(f64, f64),
     #[error("profiles have different degrees ({0} and {1}); fit every profile of a stack at the same degree")]
     MixedDegrees(usize, usize),
+    #[error("profiles of degree {0} blend into a 3-D polynomial of degree {1}, above the maximum {MAX_DEGREE}; fit the profiles at degree {max} or less", max = MAX_DEGREE - 1)]
+    DegreeTooHigh(usize, usize),
 }
 
 /// A piecewise 3-D model interpolated between parallel profiles along x.
@@ -50,6 +52,10 @@ impl ProfileStack {
             return Err(StackError::TooFewProfiles(profiles.len()));
         }
         profiles.sort_by(|a, b| a.x.total_cmp(&b.x));
+        let degree = profiles[0].model.degree();
+        if degree + 1 > MAX_DEGREE {
+            return Err(StackError::DegreeTooHigh(degree, degree + 1));
+        }
         for pair in profiles.windows(2) {
             if pair[0].x == pair[1].x {
                 return Err(StackError::SamePosition(pair[0].x, pair[1].x));

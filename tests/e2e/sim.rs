@@ -8,6 +8,7 @@ use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::transport::open_pty;
 use zeroset_sim::config::{PartSpec, SimConfig};
 use zeroset_sim::part::propeller::Propeller;
+use zeroset_sim::simulator::parse_announcement;
 
 use crate::support::{config, repo};
 
@@ -49,12 +50,7 @@ impl Sim {
             .map(|_| {
                 let mut line = String::new();
                 stdout.read_line(&mut line).expect("a line");
-                let words: Vec<&str> = line.split_whitespace().collect();
-                assert!(
-                    words.len() == 3 && words[0] == "machine",
-                    "unexpected: {line:?}"
-                );
-                (words[1].to_string(), words[2].to_string())
+                parse_announcement(&line).unwrap_or_else(|| panic!("unexpected: {line:?}"))
             })
             .collect();
         Sim {

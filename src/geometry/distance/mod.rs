@@ -56,6 +56,7 @@ impl DistanceError {
             Self::ZeroGradient => "zero-gradient",
             Self::NoZeroSetNearby => "no-zero-set-nearby",
             Self::NoFootPoint => "no-foot-point",
+            Self::OutsideModelRange => "outside-model-range",
         }
     }
 }
@@ -98,6 +99,8 @@ pub enum DistanceError {
     NoZeroSetNearby,
     #[error("no foot point found on the model")]
     NoFootPoint,
+    #[error("the point lies beyond the profiles the model interpolates")]
+    OutsideModelRange,
 }
 
 /// Signed distances (mm) of points, in order (the points of a scan seed each other), by `method`. `reach` bounds

@@ -14,6 +14,8 @@ use crate::geometry::sampling::{Aabb, ZeroSetSamples};
 const SEGMENT_CELLS_ALONG: usize = 4;
 const SEGMENT_CELLS_ACROSS: usize = 256;
 const PROFILE_CELLS: usize = 512;
+/// Points this far beyond the first or last profile plane still count as on it (a probe's x scatters too).
+const PLANE_TOLERANCE_MM: f64 = 0.05;
 
 pub struct StackDistance<'a> {
     stack: &'a ProfileStack,
@@ -57,6 +59,11 @@ impl<'a> StackDistance<'a> {
 
     pub fn foot(&self, p: &Vector3<f64>) -> Result<Foot<3>, DistanceError> {
         let profiles = self.stack.profiles();
+        // Beyond the end profiles the blend is an extrapolation, not a model of the part.
+        let (first, last) = (profiles[0].x, profiles[profiles.len() - 1].x);
+        if p.x < first - PLANE_TOLERANCE_MM || p.x > last + PLANE_TOLERANCE_MM {
+            return Err(DistanceError::OutsideModelRange);
+        }
         let k = self.stack.segment_at(p.x);
         let side = self.stack.value(p);
         let mut best: Option<Foot<3>> = None;
@@ -187,5 +194,13 @@ mod tests {
             );
             assert_eq!(foot.distance.signum(), stack.value(&p).signum());
         }
+        assert_eq!(
+            distance.foot(&Vector3::new(200.2, 10.0, 0.0)),
+            Err(DistanceError::OutsideModelRange)
+        );
+        assert_eq!(
+            distance.foot(&Vector3::new(-1.0, 10.0, 0.0)),
+            Err(DistanceError::OutsideModelRange)
+        );
     }
 }
