@@ -245,11 +245,11 @@ fn print_fit<const N: usize>(path: &Path, what: &str, fitted: &Fitted<N>) {
             s.zero_set_components
         );
     }
-    if s.inverted_side_probes > 0 {
+    if s.side_segments_crossed_again > 0 {
         println!(
-            "  warning: the model puts {} of {} points just inside or outside the data on the wrong side: \
-             deviations measured near them may have the wrong sign",
-            s.inverted_side_probes, s.side_probes
+            "  warning: the model's zero set crosses {} of {} short segments across the data more than once: \
+             a sliver of spurious surface beside the data, where deviations may have the wrong sign",
+            s.side_segments_crossed_again, s.side_segments
         );
     }
     if s.points_without_foot > 0 {

@@ -115,12 +115,12 @@ pub struct FitStats {
     pub refinement_iterations: usize,
     /// Points whose exact distance could not be computed (a defect of the model near them).
     pub points_without_foot: usize,
-    /// Points just inside and outside the data whose side is known, and how many of them the model puts on the
-    /// wrong side (any means deviations near them may have the wrong sign).
+    /// Segments across the data along the normals, and how many of them the model's zero set crosses more than
+    /// once: a sliver of spurious surface beside the data, where deviations may have the wrong sign.
     #[serde(default)]
-    pub side_probes: usize,
+    pub side_segments: usize,
     #[serde(default)]
-    pub inverted_side_probes: usize,
+    pub side_segments_crossed_again: usize,
 }
 
 impl FitStats {
@@ -213,11 +213,11 @@ pub fn fit_ip<const N: usize>(
         let mut poly = Poly::new(degree, coeffs);
         let mut refinement_iterations = 0;
         if options.method == FitMethod::Orthogonal {
-            // Unconstrained first: the most accurate, unless it puts more side probes on the wrong side than
-            // its start does; then the refinement that may not.
-            let allowed = probes.inverted(&poly);
+            // Unconstrained first: the most accurate, unless its zero set crosses more side segments again than
+            // its start's does; then the refinement that may not.
+            let allowed = probes.crossed_again(&poly);
             let refined = refine_orthogonal(&poly, &unit, None)
-                .filter(|(r, _)| probes.inverted(r) <= allowed)
+                .filter(|(r, _)| probes.crossed_again(r) <= allowed)
                 .or_else(|| refine_orthogonal(&poly, &unit, Some(&probes)));
             if let Some((refined, iterations)) = refined {
                 poly = refined;
@@ -242,8 +242,8 @@ pub fn fit_ip<const N: usize>(
         stats.offset_min_mm = min_offset * frame.scale;
         stats.offset_max_mm = max_offset * frame.scale;
         stats.refinement_iterations = refinement_iterations;
-        stats.side_probes = probes.len();
-        stats.inverted_side_probes = probes.inverted(&model.poly);
+        stats.side_segments = probes.len();
+        stats.side_segments_crossed_again = probes.crossed_again(&model.poly);
         let candidate = Fitted {
             model,
             method: options.method,
@@ -315,44 +315,59 @@ fn choose_offsets<const N: usize>(
         .collect()
 }
 
-/// Points whose side of the surface the data prove: along each point's normal, inside and outside, at half the
-/// deepest offset that stays nearer its own point than any other (so never past the middle of a thin section),
-/// where that is deep enough for the model to be expected to follow (not the last microns of a sharp edge,
-/// which no single polynomial follows). A model whose sign is wrong at one of them would report a deviation there with the wrong
-/// sign; fitting distances alone can grow such a sliver of zero set inside a trailing edge.
+/// Segments across the data along each point's normal, from inside to outside, each end half-way to the medial
+/// axis (the deepest offset that stays nearer its own point than any other), so never past the middle of a thin
+/// section. The surface crosses each such segment once, at the point. A model whose zero set crosses one more than
+/// once has a sliver of spurious surface beside the data (fitting distances alone can grow one inside a thin
+/// trailing edge), and there deviations get the wrong sign. A model that misses a segment altogether (the rounded
+/// tip of a sharp edge, which no single polynomial follows) is not counted: its distances show it.
 pub(crate) struct SideProbes<const N: usize> {
-    /// Each probe and the sign F must have there (-1 inside, +1 outside).
-    probes: Vec<(SVector<f64, N>, f64)>,
+    segments: Vec<(SVector<f64, N>, SVector<f64, N>)>,
 }
+
+/// Samples along a side segment: enough to see a sliver a tenth of the segment wide.
+const SIDE_SAMPLES: usize = 12;
 
 impl<const N: usize> SideProbes<N> {
     fn new(unit: &[SVector<f64, N>], normals: &[SVector<f64, N>]) -> Self {
-        let mut probes = Vec::with_capacity(4 * unit.len());
-        for ((u, n), o) in unit
+        let offsets = choose_offsets(unit, normals, PROBE_REACH);
+        // Segments shallower than this could be crossed twice through the probe noise alone.
+        let deep_enough = |d: Option<f64>| d.filter(|d| *d >= PROBE_MIN_DEPTH);
+        let segments = unit
             .iter()
             .zip(normals)
-            .zip(choose_offsets(unit, normals, PROBE_REACH))
-        {
-            for (depth, side) in [(o.inside, -1.0), (o.outside, 1.0)] {
-                // Probes shallower than this could sit on the wrong side through the probe noise alone.
-                if let Some(depth) = depth.filter(|d| *d >= PROBE_MIN_DEPTH) {
-                    probes.push((u + n * (side * 0.5 * depth), side));
-                }
-            }
-        }
-        Self { probes }
+            .zip(offsets)
+            .filter_map(|((u, n), o)| {
+                let inside = deep_enough(o.inside)?;
+                let outside = deep_enough(o.outside)?;
+                Some((u - n * (0.5 * inside), u + n * (0.5 * outside)))
+            })
+            .collect();
+        Self { segments }
     }
 
-    /// How many probes the polynomial (in normalised coordinates) puts on the wrong side.
-    fn inverted(&self, poly: &Poly<N>) -> usize {
-        self.probes
+    /// How many segments the polynomial's zero set (in normalised coordinates) crosses more than once.
+    fn crossed_again(&self, poly: &Poly<N>) -> usize {
+        self.segments
             .iter()
-            .filter(|(p, side)| poly.value(p) * side <= 0.0)
+            .filter(|(inside, outside)| {
+                let mut previous = poly.value(inside);
+                let mut changes = 0;
+                for k in 1..=SIDE_SAMPLES {
+                    let t = k as f64 / SIDE_SAMPLES as f64;
+                    let value = poly.value(&(inside + (outside - inside) * t));
+                    if value * previous < 0.0 {
+                        changes += 1;
+                    }
+                    previous = value;
+                }
+                changes > 1
+            })
             .count()
     }
 
     fn len(&self) -> usize {
-        self.probes.len()
+        self.segments.len()
     }
 }
 
@@ -472,7 +487,7 @@ fn feet_of<const N: usize>(
 /// residuals and would dominate distances of a few microns, and forbidding new zero-set components blocks the
 /// optimum even for the paper's own published quartic, which has a second branch inside twice its data's box.
 /// Spurious branches are therefore reported in the fit statistics (zero_set_components), not hidden. What is
-/// constrained, when `probes` are given, is the side: no step may put more side probes on the wrong side than the
+/// constrained, when `probes` are given, is the side: no step may cross more side segments more than once than the
 /// start does, since a sliver of zero set inside a thin edge would flip the sign of every deviation there.
 fn refine_orthogonal<const N: usize>(
     start: &Poly<N>,
@@ -480,9 +495,9 @@ fn refine_orthogonal<const N: usize>(
     probes: Option<&SideProbes<N>>,
 ) -> Option<(Poly<N>, usize)> {
     // With probes, a step may not put more of them on the wrong side than the start does.
-    let allowed_inverted = probes.map(|p| p.inverted(start));
-    let keeps_sides = |candidate: &Poly<N>| match (probes, allowed_inverted) {
-        (Some(p), Some(allowed)) => p.inverted(candidate) <= allowed,
+    let allowed_slivers = probes.map(|p| p.crossed_again(start));
+    let keeps_sides = |candidate: &Poly<N>| match (probes, allowed_slivers) {
+        (Some(p), Some(allowed)) => p.crossed_again(candidate) <= allowed,
         _ => true,
     };
     let projected: Vec<SVector<f64, N>> = unit
@@ -604,8 +619,8 @@ fn measure<const N: usize>(
         offset_max_mm: 0.0,
         refinement_iterations: 0,
         points_without_foot: failed,
-        side_probes: 0,
-        inverted_side_probes: 0,
+        side_segments: 0,
+        side_segments_crossed_again: 0,
     }
 }
 
