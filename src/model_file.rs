@@ -178,3 +178,57 @@ impl ModelFileError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::implicit::Frame;
+    use crate::geometry::poly::Poly;
+    use nalgebra::Vector2;
+
+    #[test]
+    fn a_saved_model_loads_bit_for_bit_and_bad_ones_are_refused_by_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.json");
+        let coefficients: Vec<f64> = (0..15).map(|i| (i as f64 * 0.7).sin() / 3.0).collect();
+        let fitted = FittedIp {
+            ip: IpModel {
+                frame: Frame {
+                    center: Vector2::new(0.1, 1.0 / 3.0),
+                    scale: 27.3,
+                },
+                poly: Poly::new(4, coefficients.clone()),
+            },
+            domain: Aabb {
+                min: Vector2::new(-1.0, -2.0),
+                max: Vector2::new(3.0, 4.0),
+            },
+            fit: None,
+        };
+        ModelFile::new("test", ReferenceModel::Profile(fitted.clone()))
+            .save(&path)
+            .unwrap();
+        let loaded = ModelFile::load(&path).unwrap();
+        assert_eq!(
+            loaded.model,
+            ReferenceModel::Profile(fitted.clone()),
+            "every coefficient round-trips exactly"
+        );
+        let mut negative = fitted.clone();
+        negative.ip.frame.scale = -3.0;
+        ModelFile::new("test", ReferenceModel::Profile(negative))
+            .save(&path)
+            .unwrap();
+        let error = ModelFile::load(&path).unwrap_err().to_string();
+        assert!(error.contains("ip.frame.scale is -3"), "{error}");
+        let mut swapped = fitted;
+        std::mem::swap(&mut swapped.domain.min, &mut swapped.domain.max);
+        ModelFile::new("test", ReferenceModel::Profile(swapped))
+            .save(&path)
+            .unwrap();
+        assert!(ModelFile::load(&path)
+            .unwrap_err()
+            .to_string()
+            .contains("domain.min must be below"));
+    }
+}
