@@ -17,6 +17,7 @@ use zeroset_drivers::transport::open_pty;
 use zeroset_sim::config::{PartSpec, SimConfig};
 use zeroset_sim::part::curve::SampledCurve;
 use zeroset_sim::part::propeller::Propeller;
+use zeroset_sim::simulator::parse_announcement;
 
 /// The top of blade A's section at radius 200 mm, from the simulator's own ground truth.
 fn top_of_blade_a() -> Xyz {
@@ -58,11 +59,7 @@ fn start_sim(dir: &Path, extra: &str, time_scale: f64) -> (Child, String) {
     BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .expect("machine line");
-    let path = line
-        .split_whitespace()
-        .nth(2)
-        .expect("machine NAME PATH")
-        .to_string();
+    let (_, path) = parse_announcement(&line).expect("machine NAME PATH");
     (child, path)
 }
 

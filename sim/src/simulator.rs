@@ -63,11 +63,8 @@ pub async fn run(config: SimConfig, time_scale: Option<f64>) -> Result<(), RunEr
             .unwrap_or_else(|| Transcript::default_path(&machine.name));
         let transcript =
             Transcript::create(&transcript_path).map_err(failed("creating the transcript"))?;
-        announce.push_str(&format!(
-            "machine {} {}\n",
-            machine.name,
-            link.address().map_err(failed("reading the address"))?
-        ));
+        let address = link.address().map_err(failed("reading the address"))?;
+        announce.push_str(&announcement(&machine.name, &address));
         let (faults_in, faults) = mpsc::channel(16);
         senders.insert(machine.name.clone(), faults_in);
         let task = Machine {
@@ -125,8 +122,37 @@ pub async fn run(config: SimConfig, time_scale: Option<f64>) -> Result<(), RunEr
     Ok(())
 }
 
+/// The line that tells a client where a machine is served: `machine NAME PATH`.
+pub fn announcement(machine: &str, address: &str) -> String {
+    format!("machine {machine} {address}\n")
+}
+
+/// Reads an announcement line back: the machine's name and where it is served.
+pub fn parse_announcement(line: &str) -> Option<(String, String)> {
+    match line.split_whitespace().collect::<Vec<_>>().as_slice() {
+        ["machine", name, address] => Some((name.to_string(), address.to_string())),
+        _ => None,
+    }
+}
+
 fn print_flushed(text: &str) -> io::Result<()> {
     let mut out = io::stdout().lock();
     out.write_all(text.as_bytes())?;
     out.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn announcements_read_back() {
+        let line = announcement("cmm1", "/dev/pts/7");
+        assert_eq!(line, "machine cmm1 /dev/pts/7\n");
+        assert_eq!(
+            parse_announcement(&line),
+            Some(("cmm1".into(), "/dev/pts/7".into()))
+        );
+        assert_eq!(parse_announcement("ok fault cmm1 estop"), None);
+    }
 }

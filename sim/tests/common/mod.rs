@@ -58,12 +58,8 @@ impl Sim {
             .map(|_| {
                 let mut line = String::new();
                 stdout.read_line(&mut line).unwrap();
-                let words: Vec<&str> = line.split_whitespace().collect();
-                assert!(
-                    words.len() == 3 && words[0] == "machine",
-                    "announcement {line:?}"
-                );
-                (words[1].to_owned(), words[2].to_owned())
+                zeroset_sim::simulator::parse_announcement(&line)
+                    .unwrap_or_else(|| panic!("announcement {line:?}"))
             })
             .collect();
         Sim {
