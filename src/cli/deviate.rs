@@ -11,7 +11,7 @@ use nalgebra::SVector;
 use super::DistanceArg;
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::{
-    paper_distance, signed_distances, taubin_distance, DistanceError, DistanceMethod, StackDistance,
+    signed_distances, DistanceError, DistanceMethod, ExactDistance, StackDistance,
 };
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
@@ -67,25 +67,13 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
                 sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
                 let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
                 let reach = 4.0 * stack.bounds(&domains).diagonal();
-                let distances = match method {
-                    DistanceMethod::Exact => {
-                        let exact = StackDistance::new(&stack, &domains);
-                        p.iter()
-                            .map(|q| exact.foot(q).map(|f| f.distance))
-                            .collect()
-                    }
-                    DistanceMethod::Paper => p
+                let distances = signed_distances(&stack, p, method, reach, |points| {
+                    let exact = StackDistance::new(&stack, &domains);
+                    points
                         .iter()
-                        .map(|q| {
-                            paper_distance(&stack, q, reach)
-                                .map(|f| f.distance)
-                                .map_err(DistanceError::from)
-                        })
-                        .collect(),
-                    DistanceMethod::Taubin => {
-                        p.iter().map(|q| taubin_distance(&stack, q)).collect()
-                    }
-                };
+                        .map(|q| exact.foot(q).map(|f| f.distance))
+                        .collect()
+                });
                 (coordinates(p), distances)
             }
             (ReferenceModel::Profile(_), PointSet::Spatial(_)) => {
@@ -127,8 +115,15 @@ fn distances_to<const N: usize>(
     points: &[SVector<f64, N>],
     method: DistanceMethod,
 ) -> Vec<Result<f64, DistanceError>> {
-    let samples = ZeroSetSamples::new(model, bounds, cells);
-    signed_distances(model, &samples, points, method, 2.0 * bounds.diagonal())
+    signed_distances(model, points, method, 2.0 * bounds.diagonal(), |points| {
+        let samples = ZeroSetSamples::new(model, bounds, cells);
+        let exact = ExactDistance::new(model, &samples);
+        exact
+            .feet_along_scan(points)
+            .into_iter()
+            .map(|foot| foot.map(|f| f.distance))
+            .collect()
+    })
 }
 
 fn write_csv(

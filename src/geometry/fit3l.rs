@@ -232,6 +232,13 @@ pub fn fit_ip<const N: usize>(
             .fold((f64::INFINITY, 0.0f64), |(lo, hi), c| {
                 (lo.min(c), hi.max(c))
             });
+        // With no safe offset at all the range is empty: record zero rather than an infinity, which JSON cannot
+        // hold (the model file would not load again).
+        let min_offset = if min_offset.is_finite() {
+            min_offset
+        } else {
+            0.0
+        };
         let cells = options.sampling_cells.unwrap_or(if N == 2 {
             PROFILE_SAMPLING_CELLS
         } else {

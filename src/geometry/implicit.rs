@@ -71,10 +71,6 @@ impl<const N: usize> Frame<N> {
     pub fn to_unit(&self, p: &SVector<f64, N>) -> SVector<f64, N> {
         (p - self.center) / self.scale
     }
-
-    pub fn to_world(&self, u: &SVector<f64, N>) -> SVector<f64, N> {
-        u * self.scale + self.center
-    }
 }
 
 /// An implicit polynomial model: F(p) = scale * P((p - center) / scale).

@@ -21,7 +21,6 @@ pub use paper::paper_distance;
 pub use stack::StackDistance;
 
 use super::implicit::Implicit;
-use super::sampling::ZeroSetSamples;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -104,20 +103,17 @@ pub enum DistanceError {
 }
 
 /// Signed distances (mm) of points, in order (the points of a scan seed each other), by `method`. `reach` bounds
-/// how far the paper's projections may travel (a few model sizes).
+/// how far the paper's projections may travel (a few model sizes). `exact` computes the exact distances; it is
+/// called only for that method, so its set-up (sampling the zero set) is not paid for the others.
 pub fn signed_distances<F: Implicit<N>, const N: usize>(
     f: &F,
-    samples: &ZeroSetSamples<N>,
     points: &[SVector<f64, N>],
     method: DistanceMethod,
     reach: f64,
+    exact: impl FnOnce(&[SVector<f64, N>]) -> Vec<Result<f64, DistanceError>>,
 ) -> Vec<Result<f64, DistanceError>> {
     match method {
-        DistanceMethod::Exact => ExactDistance::new(f, samples)
-            .feet_along_scan(points)
-            .into_iter()
-            .map(|foot| foot.map(|f| f.distance))
-            .collect(),
+        DistanceMethod::Exact => exact(points),
         DistanceMethod::Paper => points
             .iter()
             .map(|p| {
