@@ -96,21 +96,30 @@ async fn runs_transactions_with_ack_data_and_complete() {
     peer.ack_and_complete("00004").await;
     tool.await.unwrap().unwrap();
 
+    let position = spawn(&client, |client| async move { client.position().await });
+    peer.expect("00005 Get(X(), Y(), Z())").await;
+    peer.reply(&["00005 &", "00005 # X(10.5), Y(-2), Z(300.25)", "00005 %"])
+        .await;
+    assert_eq!(
+        position.await.unwrap().unwrap(),
+        Xyz::new(10.5, -2.0, 300.25)
+    );
+
     // PtMeas_Client.log: the report format first, then the measurement, answered IJK first.
     let point = spawn(&client, |client| async move {
         client
             .pt_meas(Xyz::new(1.33, -26.0, 30.998), Xyz::new(0.0, 0.0, 1.0))
             .await
     });
-    peer.expect("00005 OnPtMeasReport(X(), Y(), Z(), IJK())")
+    peer.expect("00006 OnPtMeasReport(X(), Y(), Z(), IJK())")
         .await;
-    peer.ack_and_complete("00005").await;
-    peer.expect("00006 PtMeas(X(1.33), Y(-26), Z(30.998), IJK(0, 0, 1))")
+    peer.ack_and_complete("00006").await;
+    peer.expect("00007 PtMeas(X(1.33), Y(-26), Z(30.998), IJK(0, 0, 1))")
         .await;
     peer.reply(&[
-        "00006 &",
-        "00006 # IJK(0.00000,0.00000,1.00000), X(1.33000), Y(-26.00000), Z(33.99800)",
-        "00006 %",
+        "00007 &",
+        "00007 # IJK(0.00000,0.00000,1.00000), X(1.33000), Y(-26.00000), Z(33.99800)",
+        "00007 %",
     ])
     .await;
     let point = point.await.unwrap().unwrap();

@@ -38,6 +38,11 @@ pub(crate) fn change_tool(name: &str) -> Result<Call, WireError> {
     Ok(Call::new(known_name("ChangeTool"), vec![name.into()]))
 }
 
+/// `Get(X(), Y(), Z())`: the probe centre's position (spec 6.3.2.6).
+pub(crate) fn get_position() -> Call {
+    report_format("Get", &["X", "Y", "Z"])
+}
+
 /// `GetProp(Tool.AvrRadius())`: spec 6.3.13's calibrated tip radius of the active tool.
 pub(crate) fn get_tool_radius() -> Call {
     Call::new(

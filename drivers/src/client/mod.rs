@@ -271,6 +271,10 @@ impl Machine for Client {
         self.transact(call).await.map(drop)
     }
 
+    async fn position(&self) -> Result<Xyz, Error> {
+        self.query(calls::get_position(), replies::position).await
+    }
+
     async fn go_to(&self, target: Xyz) -> Result<(), Error> {
         let call = self.call(calls::go_to(target), "GoTo")?;
         self.transact(call).await.map(drop)

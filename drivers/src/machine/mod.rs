@@ -51,6 +51,10 @@ pub trait Machine: Send + Sync {
 
     async fn set_speeds(&self, speeds: Speeds) -> Result<(), Error>;
 
+    /// Where the probe ball's centre is now (I++ `Get(X(), Y(), Z())`): a station that starts or resumes
+    /// with the probe in an unknown place retracts from here before any move across the part.
+    async fn position(&self) -> Result<Xyz, Error>;
+
     /// Moves the probe ball's centre to `target`.
     async fn go_to(&self, target: Xyz) -> Result<(), Error>;
 
