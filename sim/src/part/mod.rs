@@ -135,12 +135,27 @@ fn parallel(a: &Vector3<f64>, b: &Vector3<f64>) -> bool {
     a.normalize().dot(&b.normalize()).abs() > 1.0 - 1.5e-8
 }
 
+/// Beyond this distance from the surface, mm, the direction to a point is a reliable normal.
+const OFF_SURFACE: f64 = 1e-6;
+
+/// The nearest point of a section curve in its plane: a sampled curve, or one derived from another by a
+/// similarity (a blade's sections are one airfoil scaled, turned and shifted).
+pub trait PlaneNearest {
+    fn nearest(&self, query: &Point2<f64>) -> curve::Nearest;
+}
+
+impl<C: ClosedCurve> PlaneNearest for SampledCurve<C> {
+    fn nearest(&self, query: &Point2<f64>) -> curve::Nearest {
+        SampledCurve::nearest(self, query)
+    }
+}
+
 /// The nearest point of a prism-like solid: sections perpendicular to the frame's w axis for w in
 /// `w_range`, `section` being the one at the clamped w of `p`, closed by flat caps at both ends.
 fn prism_nearest(
     frame: &Frame,
     w_range: (f64, f64),
-    section: &SampledCurve<impl ClosedCurve>,
+    section: &impl PlaneNearest,
     p: &Point3<f64>,
 ) -> SurfacePoint {
     let local = frame.local(p);
@@ -149,10 +164,21 @@ fn prism_nearest(
     let beyond = local.z - w;
     let plane_nearest = section.nearest(&Point2::new(local.x, local.y));
     let on_curve = plane_nearest.on_curve;
-    let to_curve = |distance: f64| SurfacePoint {
-        point: frame.world(on_curve.point.x, on_curve.point.y, w),
-        normal: frame.world_dir(on_curve.normal.x, on_curve.normal.y, 0.0),
-        signed_distance: distance,
+    let to_curve = |distance: f64| {
+        let point = frame.world(on_curve.point.x, on_curve.point.y, w);
+        // Outside, the normal is the direction from the surface point to the query: the curve's own normal
+        // there, except at a sharp edge, where a ball touching the edge is pushed back along this direction and
+        // a CMM reports it (so that the centre minus one radius along it is the touched point).
+        let normal = if distance > OFF_SURFACE {
+            (p - point) / (p - point).norm()
+        } else {
+            frame.world_dir(on_curve.normal.x, on_curve.normal.y, 0.0)
+        };
+        SurfacePoint {
+            point,
+            normal,
+            signed_distance: distance,
+        }
     };
     let to_cap = |cap: f64, distance: f64| SurfacePoint {
         point: frame.world(local.x, local.y, cap),

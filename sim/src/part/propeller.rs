@@ -13,11 +13,14 @@
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Point2, Point3, Vector3};
+use nalgebra::{Isometry3, Point2, Point3, Vector2, Vector3};
 use serde::Deserialize;
 
-use super::curve::{ClosedCurve, SampledCurve};
-use super::{parallel, prism_nearest, AnyCurve, Frame, Part, Plane, Pose, Section, SurfacePoint};
+use super::curve::{ClosedCurve, CurvePoint, Nearest, SampledCurve};
+use super::{
+    parallel, prism_nearest, AnyCurve, Frame, Part, Plane, PlaneNearest, Pose, Section,
+    SurfacePoint,
+};
 use crate::naca::Naca4;
 
 /// The propeller as configured (`kind = "propeller"` in config/sims/*.toml).
@@ -89,6 +92,36 @@ pub struct Propeller {
     spec: PropellerSpec,
     foil: Naca4,
     pose: Isometry3<f64>,
+    /// The airfoil of unit chord, sampled once: every blade section is it scaled, turned and shifted, so a
+    /// nearest-point query needs no new samples (a scan asks thousands of them).
+    unit: SampledCurve<BladeSection>,
+}
+
+/// A blade section as a similarity of the unit-chord airfoil: exact, since a NACA section scales with its chord.
+struct ScaledSection<'a> {
+    unit: &'a SampledCurve<BladeSection>,
+    chord: f64,
+    angle: f64,
+    shift: f64,
+}
+
+impl PlaneNearest for ScaledSection<'_> {
+    fn nearest(&self, query: &Point2<f64>) -> Nearest {
+        let (sin, cos) = self.angle.sin_cos();
+        let (u, v) = (query.x, query.y - self.shift);
+        let in_unit = Point2::new(u * cos + v * sin, -u * sin + v * cos) / self.chord;
+        let unit = self.unit.nearest(&in_unit);
+        let turn = |w: Vector2<f64>| Vector2::new(w.x * cos - w.y * sin, w.x * sin + w.y * cos);
+        let point = turn(unit.on_curve.point.coords * self.chord) + Vector2::new(0.0, self.shift);
+        Nearest {
+            on_curve: CurvePoint {
+                s: unit.on_curve.s,
+                point: Point2::from(point),
+                normal: turn(unit.on_curve.normal),
+            },
+            signed_distance: unit.signed_distance * self.chord,
+        }
+    }
 }
 
 impl Propeller {
@@ -110,24 +143,40 @@ impl Propeller {
             return Err(PropellerError::BadDimensions);
         }
         let pose = spec.pose.isometry();
-        Ok(Propeller { spec, foil, pose })
+        let unit = SampledCurve::new(BladeSection {
+            foil,
+            angle: 0.0,
+            shift: 0.0,
+        });
+        Ok(Propeller {
+            spec,
+            foil,
+            pose,
+            unit,
+        })
     }
 
     /// The blade's section at `radius` in its plane's (u, v) coordinates, with the blade's error.
     pub fn section_curve(&self, blade: usize, radius: f64) -> BladeSection {
+        let (chord, angle, shift) = self.section_placement(blade, radius);
+        BladeSection {
+            foil: Naca4 {
+                chord_mm: chord,
+                ..self.foil
+            },
+            angle,
+            shift,
+        }
+    }
+
+    /// Chord, turn and shift of the blade's section at `radius`.
+    fn section_placement(&self, blade: usize, radius: f64) -> (f64, f64, f64) {
         let error = &self.spec.blade_errors[blade];
         let along = self.along(radius);
         let angle = (self.spec.pitch_mm / (TAU * radius)).atan()
             + along(self.spec.twist_deg).to_radians()
             + along(error.twist_deg).to_radians();
-        BladeSection {
-            foil: Naca4 {
-                chord_mm: along(self.spec.chord_mm),
-                ..self.foil
-            },
-            angle,
-            shift: along(error.shift_mm),
-        }
+        (along(self.spec.chord_mm), angle, along(error.shift_mm))
     }
 
     /// The plane frame of the blade's section at `radius`, in machine coordinates: origin on the blade
@@ -157,7 +206,13 @@ impl Propeller {
         let axis = self.section_frame(blade, 0.0);
         let range = (self.spec.root_radius_mm, self.spec.tip_radius_mm);
         let radius = axis.local(p).z.clamp(range.0, range.1);
-        let section = SampledCurve::new(self.section_curve(blade, radius));
+        let (chord, angle, shift) = self.section_placement(blade, radius);
+        let section = ScaledSection {
+            unit: &self.unit,
+            chord,
+            angle,
+            shift,
+        };
         prism_nearest(&axis, range, &section, p)
     }
 
@@ -333,6 +388,38 @@ mod tests {
             assert!((nearest.point - surface).norm() < 1e-5);
             let inside = propeller.nearest(&(surface - outward * 0.5));
             assert!(inside.signed_distance < 0.0);
+        }
+    }
+
+    #[test]
+    fn the_scaled_unit_section_is_the_sampled_section() {
+        let propeller = Propeller::new(spec()).unwrap();
+        for (blade, radius) in [(0, 100.0), (1, 333.3), (2, 560.0)] {
+            let sampled = SampledCurve::new(propeller.section_curve(blade, radius));
+            let (chord, angle, shift) = propeller.section_placement(blade, radius);
+            let scaled = ScaledSection {
+                unit: &propeller.unit,
+                chord,
+                angle,
+                shift,
+            };
+            for query in [[3.0, 40.0], [-70.0, -5.0], [0.5, 0.2], [55.0, -60.0]] {
+                let query = Point2::from(query);
+                let a = SampledCurve::nearest(&sampled, &query);
+                let b = PlaneNearest::nearest(&scaled, &query);
+                assert!(
+                    (a.signed_distance - b.signed_distance).abs() < 1e-9,
+                    "{a:?} {b:?}"
+                );
+                // The parameter search ends where the distance is flat to rounding, which moves the foot by
+                // about 1e-7 of the distance either way (a nanometre at 10 mm).
+                let flat = 1e-7 * (1.0 + a.signed_distance.abs());
+                assert!(
+                    (a.on_curve.point - b.on_curve.point).norm() < flat,
+                    "{query}: {a:?} {b:?}"
+                );
+                assert!((a.on_curve.normal - b.on_curve.normal).norm() < 1e-6);
+            }
         }
     }
 
