@@ -20,6 +20,10 @@ pub struct SimArgs {
     /// Machine seconds per wall-clock second, overriding the file's time_scale (100 = 100x faster).
     #[arg(long)]
     pub time_scale: Option<f64>,
+    /// Also link DIR/NAME to each pseudo-terminal machine's path (DIR is created if missing; a stale link
+    /// is replaced), so that a station can name a fixed port. The links are removed on exit.
+    #[arg(long, value_name = "DIR")]
+    pub link_dir: Option<PathBuf>,
 }
 
 /// Loads the configuration and serves its machines until stopped.
@@ -35,7 +39,11 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    let served = runtime.block_on(crate::simulator::run(config, args.time_scale));
+    let served = runtime.block_on(crate::simulator::run(
+        config,
+        args.time_scale,
+        args.link_dir.as_deref(),
+    ));
     // Standard input is read on a blocking thread that no signal interrupts: waiting for it (what dropping the
     // runtime does) would keep a simulator told to stop by SIGTERM alive until its stdin closes.
     runtime.shutdown_background();

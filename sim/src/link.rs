@@ -1,9 +1,11 @@
 //! The line a machine is reached on: a pseudo-terminal in raw mode (CR LF pass untouched) or a loopback
 //! TCP port. A client may go away and come back: the pty's master stays open, so its slave path can be
-//! reopened, and the TCP listener accepts the next connection.
+//! reopened, and the TCP listener accepts the next connection. [`PtyLinks`] gives the pseudo-terminals fixed
+//! paths (`--link-dir`), whatever /dev/pts numbers they got.
 
 use std::io;
 use std::os::fd::{AsFd, OwnedFd};
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use nix::fcntl::{fcntl, FcntlArg, OFlag};
@@ -147,6 +149,65 @@ impl Link {
     }
 }
 
+/// Symbolic links DIR/NAME to machines' pseudo-terminals, so that a station file can name a fixed path. The
+/// links this made are removed when it is dropped, unless something else has replaced them since.
+#[derive(Debug, Default)]
+pub struct PtyLinks {
+    /// Each link made, with the pty path it points at.
+    made: Vec<(PathBuf, PathBuf)>,
+}
+
+impl PtyLinks {
+    /// Links `dir/machine` to `pty`, creating `dir` if missing. A symbolic link already there is taken as
+    /// stale (left by a simulator that was killed) and replaced; anything else there is refused rather than
+    /// overwritten. Errors name the path.
+    pub fn link(&mut self, dir: &Path, machine: &str, pty: &str) -> io::Result<PathBuf> {
+        let named = |e: io::Error, path: &Path| {
+            io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+        };
+        if machine.is_empty() || machine.contains('/') || machine == "." || machine == ".." {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("the machine name {machine:?} cannot be a file name in --link-dir"),
+            ));
+        }
+        std::fs::create_dir_all(dir).map_err(|e| named(e, dir))?;
+        let link = dir.join(machine);
+        let occupied =
+            std::fs::symlink_metadata(&link).is_ok_and(|found| !found.file_type().is_symlink());
+        if occupied {
+            return Err(io::Error::new(
+                io::ErrorKind::AlreadyExists,
+                format!(
+                    "{} exists and is not a symbolic link; move it away",
+                    link.display()
+                ),
+            ));
+        }
+        // Made beside it and renamed over it, so that a client never finds the path missing or half made.
+        let fresh = dir.join(format!(".{machine}.link-{}", std::process::id()));
+        let _ = std::fs::remove_file(&fresh);
+        std::os::unix::fs::symlink(pty, &fresh).map_err(|e| named(e, &fresh))?;
+        if let Err(e) = std::fs::rename(&fresh, &link) {
+            let _ = std::fs::remove_file(&fresh);
+            return Err(named(e, &link));
+        }
+        self.made.push((link.clone(), PathBuf::from(pty)));
+        Ok(link)
+    }
+}
+
+impl Drop for PtyLinks {
+    fn drop(&mut self) {
+        for (link, pty) in &self.made {
+            // Best effort on the way out; a link another simulator has made since is its own.
+            if std::fs::read_link(link).is_ok_and(|target| target == *pty) {
+                let _ = std::fs::remove_file(link);
+            }
+        }
+    }
+}
+
 impl Pty {
     fn master(&self) -> &AsyncFd<OwnedFd> {
         self.master.as_ref().expect("registered")
@@ -208,5 +269,71 @@ impl Pty {
             }
         }
         Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_link_replaces_a_stale_one_and_goes_when_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let ports = dir.path().join("ports");
+        std::fs::create_dir(&ports).unwrap();
+        std::os::unix::fs::symlink("/dev/pts/no-such-terminal", ports.join("cmm1")).unwrap();
+        let mut links = PtyLinks::default();
+        let link = links.link(&ports, "cmm1", "/dev/null").unwrap();
+        assert_eq!(link, ports.join("cmm1"));
+        assert_eq!(
+            std::fs::read_link(&link).unwrap(),
+            PathBuf::from("/dev/null")
+        );
+        let names: Vec<_> = std::fs::read_dir(&ports)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["cmm1"], "no temporary link left behind");
+        drop(links);
+        assert!(
+            std::fs::symlink_metadata(&link).is_err(),
+            "the link is removed"
+        );
+    }
+
+    #[test]
+    fn the_folder_is_made_and_a_link_made_since_by_another_is_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let ports = dir.path().join("a/b");
+        let mut links = PtyLinks::default();
+        let link = links.link(&ports, "cmm2", "/dev/null").unwrap();
+        std::fs::remove_file(&link).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+        drop(links);
+        assert_eq!(
+            std::fs::read_link(&link).unwrap(),
+            PathBuf::from("/dev/zero")
+        );
+    }
+
+    #[test]
+    fn a_file_in_the_way_and_a_name_with_a_slash_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cmm1"), "notes").unwrap();
+        let mut links = PtyLinks::default();
+        let error = links
+            .link(dir.path(), "cmm1", "/dev/null")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("is not a symbolic link"), "{error}");
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("cmm1")).unwrap(),
+            "notes"
+        );
+        let error = links
+            .link(dir.path(), "../cmm1", "/dev/null")
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("cannot be a file name"), "{error}");
     }
 }

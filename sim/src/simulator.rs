@@ -1,10 +1,12 @@
-//! The whole simulator: opens every configured machine's line, prints `machine NAME PATH` for each, then
-//! serves them (one task per machine) until SIGINT, SIGTERM or the end of standard input. Standard input
-//! is also the fault channel: `fault MACHINE KIND [ARG]` per line (see faults.rs), answered on standard
-//! output with `ok fault MACHINE KIND` or `error: WHY`.
+//! The whole simulator: opens every configured machine's line, links each pseudo-terminal into the link
+//! folder if one is given, prints `machine NAME PATH` for each, then serves them (one task per machine)
+//! until SIGINT, SIGTERM or the end of standard input. Standard input is also the fault channel:
+//! `fault MACHINE KIND [ARG]` per line (see faults.rs), answered on standard output with
+//! `ok fault MACHINE KIND` or `error: WHY`.
 
 use std::collections::HashMap;
 use std::io::{self, Write};
+use std::path::Path;
 
 use tokio::io::{AsyncBufReadExt, BufReader};
 use tokio::signal::unix::{signal, SignalKind};
@@ -12,7 +14,7 @@ use tokio::sync::{mpsc, watch};
 
 use crate::config::{PortKind, SimConfig};
 use crate::faults::FaultRequest;
-use crate::link::Link;
+use crate::link::{Link, PtyLinks};
 use crate::machine::{Clock, Machine};
 use crate::protocol::Controller;
 use crate::transcript::Transcript;
@@ -32,13 +34,20 @@ pub enum RunError {
     Part(String),
 }
 
-/// Runs the configured machines; `time_scale` overrides the file's.
-pub async fn run(config: SimConfig, time_scale: Option<f64>) -> Result<(), RunError> {
+/// Runs the configured machines; `time_scale` overrides the file's. With `link_dir`, each pty machine's
+/// path is also linked as `link_dir/NAME` (the announcement still gives the real path) until the run ends.
+pub async fn run(
+    config: SimConfig,
+    time_scale: Option<f64>,
+    link_dir: Option<&Path>,
+) -> Result<(), RunError> {
     let clock = Clock::new(time_scale.unwrap_or(config.time_scale));
     let (stop, shutdown) = watch::channel(false);
     let mut senders = HashMap::new();
     let mut tasks = Vec::new();
     let mut announce = String::new();
+    // Dropped on every way out of this function, which removes the links.
+    let mut links = PtyLinks::default();
     for machine in &config.machines {
         let failed = |what| {
             let machine = machine.name.clone();
@@ -64,6 +73,11 @@ pub async fn run(config: SimConfig, time_scale: Option<f64>) -> Result<(), RunEr
         let transcript =
             Transcript::create(&transcript_path).map_err(failed("creating the transcript"))?;
         let address = link.address().map_err(failed("reading the address"))?;
+        if let (Some(dir), PortKind::Pty) = (link_dir, machine.port) {
+            links
+                .link(dir, &machine.name, &address)
+                .map_err(failed("linking its pseudo-terminal into --link-dir"))?;
+        }
         announce.push_str(&announcement(&machine.name, &address));
         let (faults_in, faults) = mpsc::channel(16);
         senders.insert(machine.name.clone(), faults_in);
