@@ -1,0 +1,194 @@
+//! Live deviation: the signed orthogonal distance of each arriving point to its reference profile's 2-D IP.
+//!
+//! A gauge is built once per profile (sampling the zero set is the expensive part, milliseconds) and shared by
+//! every scan of that profile; a scan's measurer seeds each point's foot from the previous one, so a point along a
+//! scan costs a Newton solve of a few iterations (microseconds).
+
+use nalgebra::{Point3, Vector2};
+use serde::{Deserialize, Serialize};
+
+use super::reference::Reference;
+use crate::geometry::distance::{DistanceError, ExactDistance, Foot};
+use crate::geometry::implicit::IpModel;
+use crate::geometry::sampling::{Aabb, ZeroSetSamples};
+use crate::model_file::ReferenceModel;
+
+/// The zero set is sampled over the profile's data box enlarged by this on every side: it covers any deviation
+/// worth measuring (a blade 10 mm off is scrap), and points beyond it still get a distance, from farther seeds.
+const SAMPLING_MARGIN_MM: f64 = 10.0;
+/// Grid cells along the longest side of the sampled box, as for the fit statistics: a cell of a fraction of a
+/// millimetre on a blade section, fine enough to seed Newton on the near face of a thin trailing edge.
+const SAMPLING_CELLS: usize = 512;
+
+/// Everything needed to measure points against one reference profile, built once per profile (samples its zero
+/// set over its domain, enlarged by a margin that covers the expected deviations).
+pub struct ProfileGauge {
+    name: String,
+    x_mm: f64,
+    model: IpModel<2>,
+    samples: ZeroSetSamples<2>,
+}
+
+impl ProfileGauge {
+    /// The gauge of `reference.profiles[profile]`. Panics when `profile` is out of range or the model is not a
+    /// stack, neither of which a taught or loaded reference allows (a programming error).
+    pub fn new(reference: &Reference, profile: usize) -> Self {
+        let ReferenceModel::Stack { profiles } = &reference.model.model else {
+            panic!(
+                "the reference of part '{}' has no stack of profile models",
+                reference.part
+            );
+        };
+        let taught = &reference.profiles[profile];
+        let fitted = &profiles[profile].fitted;
+        let margin = Vector2::repeat(SAMPLING_MARGIN_MM);
+        let bounds = Aabb {
+            min: fitted.domain.min - margin,
+            max: fitted.domain.max + margin,
+        };
+        Self {
+            name: taught.name.clone(),
+            x_mm: taught.x_mm,
+            samples: ZeroSetSamples::new(&fitted.ip, &bounds, SAMPLING_CELLS),
+            model: fitted.ip.clone(),
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The position of the profile's plane along the part's x axis, mm.
+    pub fn x_mm(&self) -> f64 {
+        self.x_mm
+    }
+
+    /// A measurer for one scan: keeps the previous point's foot so consecutive points are fast.
+    pub fn scan(&self) -> ScanGauge<'_> {
+        ScanGauge {
+            gauge: self,
+            previous: None,
+        }
+    }
+}
+
+/// The measurer of one scan of a profile: the points must come in scan order for the seeding to help (any order
+/// gives the same distances, only slower).
+pub struct ScanGauge<'g> {
+    gauge: &'g ProfileGauge,
+    /// The last point that got a foot, in the profile's (y, z) plane, and its foot.
+    previous: Option<(Vector2<f64>, Foot<2>)>,
+}
+
+/// The deviation of one point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PointDeviation {
+    /// Signed orthogonal distance to the profile's model, mm, positive outside the material.
+    pub deviation_mm: f64,
+    /// The point's x minus the profile plane's x, mm.
+    pub off_plane_mm: f64,
+    /// The nearest point of the profile's model, part frame, mm.
+    pub foot: [f64; 3],
+}
+
+impl ScanGauge<'_> {
+    /// Signed deviation (mm, positive outside) of a compensated part-frame point; its distance from the profile's
+    /// plane is returned too (a point far off the plane means a wrong transform or a wrong profile).
+    ///
+    /// The point is measured in the profile's plane: its x is set aside, as the profile's model knows nothing of
+    /// x. A point with a non-finite coordinate has no foot.
+    pub fn measure(&mut self, surface: &Point3<f64>) -> Result<PointDeviation, DistanceError> {
+        let off_plane_mm = surface.x - self.gauge.x_mm;
+        let in_plane = Vector2::new(surface.y, surface.z);
+        if !(off_plane_mm.is_finite() && in_plane.iter().all(|c| c.is_finite())) {
+            return Err(DistanceError::NoFootPoint);
+        }
+        let exact = ExactDistance::new(&self.gauge.model, &self.gauge.samples);
+        let previous = self.previous.as_ref().map(|(point, foot)| (point, foot));
+        // A point without a foot leaves the previous one in place: the next point still starts from a good foot.
+        let foot = exact.foot(&in_plane, previous)?;
+        self.previous = Some((in_plane, foot));
+        Ok(PointDeviation {
+            deviation_mm: foot.distance,
+            off_plane_mm,
+            foot: [self.gauge.x_mm, foot.point.x, foot.point.y],
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::test_profiles::{taught_ellipses, Ellipse};
+
+    fn assert_send_sync<T: Send + Sync + 'static>() {}
+
+    #[test]
+    fn a_gauge_can_be_shared_between_threads() {
+        assert_send_sync::<ProfileGauge>();
+    }
+
+    /// Points offset along the true normal of each ellipse by +0.3 mm (outside) and -0.3 mm (inside) read 0.3 mm
+    /// with their sign, along a scan and one by one; the x offset is reported, not measured.
+    #[test]
+    fn offsets_along_the_true_normal_read_back_within_five_microns() {
+        let reference = taught_ellipses();
+        let mut worst: f64 = 0.0;
+        let mut seeded = (0, std::time::Duration::ZERO);
+        for (index, ellipse) in Ellipse::stack().iter().enumerate() {
+            let gauge = ProfileGauge::new(reference, index);
+            assert_eq!(gauge.name(), ellipse.name());
+            for offset in [0.3, -0.3] {
+                let mut scan = gauge.scan();
+                // Between the taught points, so nothing is read off the fitted data.
+                for k in 0..300 {
+                    let t = std::f64::consts::TAU * (k as f64 + 0.37) / 300.0;
+                    let mut p = ellipse.offset_point(t, offset);
+                    p.x += 0.7;
+                    let started = std::time::Instant::now();
+                    let along = scan.measure(&p).unwrap();
+                    seeded = (seeded.0 + 1, seeded.1 + started.elapsed());
+                    let alone = gauge.scan().measure(&p).unwrap();
+                    assert!(
+                        (along.deviation_mm - alone.deviation_mm).abs() < 1e-6,
+                        "seeded {along:?} and unseeded {alone:?} disagree"
+                    );
+                    assert!((along.off_plane_mm - 0.7).abs() < 1e-9, "{along:?}");
+                    assert_eq!(along.foot[0], ellipse.x);
+                    let error = along.deviation_mm - offset;
+                    worst = worst.max(error.abs());
+                    assert!(
+                        error.abs() < 5e-3,
+                        "{} at t = {t:.3}: read {:.6} mm for {offset} mm",
+                        ellipse.name(),
+                        along.deviation_mm
+                    );
+                    let foot_on_ellipse = ellipse.distance_in_plane(along.foot[1], along.foot[2]);
+                    assert!(foot_on_ellipse.abs() < 5e-3, "foot {:?}", along.foot);
+                }
+            }
+        }
+        let per_point = seeded.1.as_secs_f64() / seeded.0 as f64;
+        eprintln!(
+            "worst error {worst:.2e} mm; {:.1} us per point along a scan",
+            per_point * 1e6
+        );
+    }
+
+    #[test]
+    fn a_point_with_no_coordinates_has_no_foot_and_the_scan_goes_on() {
+        let reference = taught_ellipses();
+        let ellipse = &Ellipse::stack()[2];
+        let gauge = ProfileGauge::new(reference, 2);
+        let mut scan = gauge.scan();
+        let before = scan.measure(&ellipse.offset_point(0.1, 0.2)).unwrap();
+        assert_eq!(
+            scan.measure(&Point3::new(f64::NAN, 0.0, 0.0)),
+            Err(DistanceError::NoFootPoint)
+        );
+        let after = scan.measure(&ellipse.offset_point(0.12, 0.2)).unwrap();
+        assert!(
+            (before.deviation_mm - 0.2).abs() < 5e-3 && (after.deviation_mm - 0.2).abs() < 5e-3
+        );
+    }
+}

@@ -1,0 +1,62 @@
+//! The station's analysis layer: teaching a reference from the master's profiles, the live signed deviation of
+//! each arriving point against it, and the running statistics and tolerance verdicts of those deviations.
+//!
+//! Frames: the CMM reports machine coordinates; the daemon moves compensated points into the part frame of the
+//! master (hub axis z, master blade along +x, profiles in the planes x = const) before they reach a gauge here.
+
+pub mod deviation;
+mod nominals;
+pub mod reference;
+pub mod stats;
+#[cfg(test)]
+mod test_profiles;
+
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+
+pub use deviation::{PointDeviation, ProfileGauge, ScanGauge};
+pub use reference::{
+    teach, MasterProfile, NominalPoint, Reference, ReferenceFileError, ReferenceProfile,
+    ReferenceSettings, TeachError,
+};
+pub use stats::{DeviationStats, RunningStats, Tolerance, Verdict};
+
+/// A point as the machine reported it: ball centre and outward unit normal (mm, machine frame), I++ quality.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RawPoint {
+    pub centre: [f64; 3],
+    pub normal: [f64; 3],
+    pub quality: f64,
+}
+
+/// The surface point a CMM's ball touched: the centre moved back one ball radius along the normal.
+///
+/// The normal is normalised first: controllers report it to a few digits only, and a normal 0.1 % long would
+/// misplace the point by 0.1 % of the ball radius. A zero normal gives non-finite coordinates, which a gauge
+/// refuses to measure.
+pub fn surface_point(raw: &RawPoint, ball_radius_mm: f64) -> Point3<f64> {
+    let normal = Vector3::from(raw.normal);
+    Point3::from(raw.centre) - normal / normal.norm() * ball_radius_mm
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_surface_point_is_one_radius_inside_the_centre_along_the_normal() {
+        let raw = RawPoint {
+            centre: [10.0, 20.0, 30.0],
+            // Not quite unit, as a controller rounds it: 3-4-0 scaled by 1.0002.
+            normal: [0.6 * 1.0002, 0.8 * 1.0002, 0.0],
+            quality: 1.0,
+        };
+        let p = surface_point(&raw, 2.5);
+        assert!((p - Point3::new(8.5, 18.0, 30.0)).norm() < 1e-12, "{p}");
+        let zero = RawPoint {
+            normal: [0.0; 3],
+            ..raw
+        };
+        assert!(surface_point(&zero, 2.5).iter().any(|c| !c.is_finite()));
+    }
+}

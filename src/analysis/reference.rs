@@ -1,0 +1,219 @@
+//! Teaching: one 2-D implicit polynomial per scanned profile of the master, blended along x into the 3-D stack
+//! (seed 003 section 4), together with the nominal points the other instances are scanned along. The result is
+//! saved as a versioned JSON file that says what was fitted, how, when and how well.
+
+use std::time::SystemTime;
+
+use nalgebra::{Point3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+
+mod file;
+
+pub use self::file::ReferenceFileError;
+use super::nominals::thin_to_nominals;
+pub use super::nominals::NominalPoint;
+use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions};
+use crate::geometry::interp::StackError;
+use crate::model_file::{stack_of, FittedIp, ModelFile, ReferenceModel, StackProfile};
+
+pub const FORMAT: &str = "zeroset-reference";
+pub const VERSION: u32 = 1;
+pub const UNITS: &str = "mm";
+
+/// How a reference is taught.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceSettings {
+    /// Degree of each profile's polynomial (the stack between profiles is one degree higher).
+    pub degree: usize,
+    pub method: FitMethod,
+    /// Largest distance between consecutive nominal points, mm.
+    pub nominal_spacing_mm: f64,
+}
+
+/// One scanned profile of the master, already compensated and in the part frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MasterProfile {
+    pub name: String,
+    pub x_mm: f64,
+    /// Surface points in scan order, mm.
+    pub points: Vec<Point3<f64>>,
+    /// The outward surface normal at each point (any length but zero).
+    pub normals: Vec<Vector3<f64>>,
+}
+
+/// The taught reference: versioned JSON file (format "zeroset-reference", version 1, units "mm").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    pub format: String,
+    pub version: u32,
+    pub units: String,
+    pub part: String,
+    /// RFC 3339, UTC, whole seconds.
+    pub taught_at: String,
+    pub settings: ReferenceSettings,
+    /// A stack: one 2-D IP per profile at its x, with its fit statistics.
+    pub model: ModelFile,
+    /// The same order as the model's stack profiles.
+    pub profiles: Vec<ReferenceProfile>,
+}
+
+/// One taught profile: its name, its plane and the nominal points to scan it along.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceProfile {
+    pub name: String,
+    pub x_mm: f64,
+    pub nominals: Vec<NominalPoint>,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TeachError {
+    #[error(
+        "a reference needs at least 2 profiles of the master, got {got}; add profiles to the plan"
+    )]
+    TooFewProfiles { got: usize },
+    #[error("two profiles of the master are named '{name}'; give every profile its own name")]
+    DuplicateName { name: String },
+    #[error(
+        "the nominal spacing {spacing_mm} mm is not a positive length; set a spacing of a few mm"
+    )]
+    BadSpacing { spacing_mm: f64 },
+    #[error("profile '{name}' (x = {x_mm} mm): {points} points but {normals} normals; every point needs its normal")]
+    NormalCount {
+        name: String,
+        x_mm: f64,
+        points: usize,
+        normals: usize,
+    },
+    #[error("profile '{name}' (x = {x_mm} mm), point {index}: the surface normal has no component in the profile's plane (it is zero or runs along x); check the machine's normals, or rescan the profile")]
+    NormalOutOfPlane {
+        name: String,
+        x_mm: f64,
+        index: usize,
+    },
+    #[error("profile '{name}' (x = {x_mm} mm): {problem}")]
+    Fit {
+        name: String,
+        x_mm: f64,
+        problem: FitError,
+    },
+    #[error("the profiles do not blend into one 3-D model: {0}")]
+    Stack(#[from] StackError),
+}
+
+/// Fits one 2-D IP per profile (in the (y, z) plane of the profile, from the points' y, z and the normals' y, z),
+/// blends them into the 3-D stack (must succeed: check with stack_of), and keeps the nominals.
+///
+/// A normal's (y, z) part is normalised before fitting: on a twisted blade the surface normal leans along x, and
+/// the profile curve's own normal is the surface normal's projection onto the plane. Profiles are fitted in
+/// parallel (one thread each): the fits are independent and CPU-bound, the orthogonal refinement most of all.
+pub fn teach(
+    part: &str,
+    profiles: &[MasterProfile],
+    settings: &ReferenceSettings,
+) -> Result<Reference, TeachError> {
+    let spacing_mm = settings.nominal_spacing_mm;
+    if !(spacing_mm.is_finite() && spacing_mm > 0.0) {
+        return Err(TeachError::BadSpacing { spacing_mm });
+    }
+    if profiles.len() < 2 {
+        return Err(TeachError::TooFewProfiles {
+            got: profiles.len(),
+        });
+    }
+    for (i, profile) in profiles.iter().enumerate() {
+        if profiles[..i].iter().any(|p| p.name == profile.name) {
+            return Err(TeachError::DuplicateName {
+                name: profile.name.clone(),
+            });
+        }
+    }
+    let options = FitOptions::new(settings.degree, settings.method);
+    let fitted: Vec<StackProfile> = std::thread::scope(|scope| {
+        let fits: Vec<_> = profiles
+            .iter()
+            .map(|profile| scope.spawn(|| fit_profile(profile, &options)))
+            .collect();
+        fits.into_iter()
+            .map(|fit| {
+                fit.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect::<Result<_, _>>()
+    })?;
+    stack_of(&fitted)?;
+    let taught = profiles
+        .iter()
+        .map(|p| ReferenceProfile {
+            name: p.name.clone(),
+            x_mm: p.x_mm,
+            nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
+        })
+        .collect();
+    Ok(Reference {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        units: UNITS.to_string(),
+        part: part.to_string(),
+        taught_at: humantime::format_rfc3339_seconds(SystemTime::now()).to_string(),
+        settings: *settings,
+        model: ModelFile::new(
+            settings.method.describe(),
+            ReferenceModel::Stack { profiles: fitted },
+        ),
+        profiles: taught,
+    })
+}
+
+/// The 2-D fit of one profile in its (y, z) plane, with warnings for the statistics an operator should see.
+fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackProfile, TeachError> {
+    let (name, x_mm) = (profile.name.clone(), profile.x_mm);
+    if profile.normals.len() != profile.points.len() {
+        return Err(TeachError::NormalCount {
+            name,
+            x_mm,
+            points: profile.points.len(),
+            normals: profile.normals.len(),
+        });
+    }
+    let points: Vec<Vector2<f64>> = profile
+        .points
+        .iter()
+        .map(|p| Vector2::new(p.y, p.z))
+        .collect();
+    let mut normals = Vec::with_capacity(profile.normals.len());
+    for (index, n) in profile.normals.iter().enumerate() {
+        match Vector2::new(n.y, n.z).try_normalize(0.0) {
+            Some(unit) if unit.iter().all(|c| c.is_finite()) => normals.push(unit),
+            _ => return Err(TeachError::NormalOutOfPlane { name, x_mm, index }),
+        }
+    }
+    let fitted = fit_ip(&points, &normals, options).map_err(|problem| TeachError::Fit {
+        name: name.clone(),
+        x_mm,
+        problem,
+    })?;
+    let stats = &fitted.stats;
+    if stats.zero_set_components > 1 || stats.side_segments_crossed_again > 0 {
+        tracing::warn!(
+            profile = %name,
+            x_mm,
+            zero_set_components = stats.zero_set_components,
+            side_segments_crossed_again = stats.side_segments_crossed_again,
+            "the reference profile's model has a spurious branch or sliver near the data; deviations near it \
+             may be wrong: check them, or teach again with another degree or method"
+        );
+    }
+    Ok(StackProfile {
+        x: x_mm,
+        fitted: FittedIp {
+            ip: fitted.model,
+            domain: fitted.domain,
+            fit: Some(fitted.stats),
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests;

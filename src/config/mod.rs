@@ -1,0 +1,110 @@
+//! The station's configuration files: config/station.toml (machines, probe, safety, folders: see
+//! [`station`]) and config/parts/NAME.toml (a part's instances, profiles and scan settings: see [`part`]).
+//!
+//! Both are TOML read with serde and `deny_unknown_fields`, so that a misspelt key is an error rather than a
+//! silently ignored setting. Every error names the file; parse errors add toml's own report of the key and
+//! line. Relative paths in a file are resolved against that file's folder, so the station works from any
+//! working directory.
+
+pub mod part;
+pub mod station;
+
+use std::path::{Component, Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+
+pub use part::{
+    Instances, PartConfig, ProfileEntry, ReferenceEntry, ReferenceKind, ScanSettings,
+    ToleranceEntry,
+};
+pub use station::{Control, Folders, MachineEntry, Pose, ProbeSettings, Safety, StationConfig};
+
+/// Why a configuration file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{}: cannot read the file ({source}); check the path and its permissions", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", path.display())]
+    Parse {
+        path: PathBuf,
+        source: toml::de::Error,
+    },
+    #[error("{}: {problem}", path.display())]
+    Invalid { path: PathBuf, problem: String },
+}
+
+/// Reads and deserialises a TOML file; errors name it.
+fn read_toml<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.to_owned(),
+        source,
+    })?;
+    toml::from_str(&text).map_err(|source| ConfigError::Parse {
+        path: path.to_owned(),
+        source,
+    })
+}
+
+/// The absolute folder that holds `file`, against which the file's relative paths are resolved.
+fn folder_of(file: &Path) -> Result<PathBuf, ConfigError> {
+    let folder = match file.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    folder.canonicalize().map_err(|source| ConfigError::Read {
+        path: file.to_owned(),
+        source,
+    })
+}
+
+/// `path` made absolute against `folder` (itself absolute, with no symbolic links: see [`folder_of`]),
+/// with `.` and `..` removed so that logs and reports show plain paths.
+fn resolve(folder: &Path, path: &Path) -> PathBuf {
+    let mut resolved = PathBuf::new();
+    for component in folder.join(path).components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                resolved.pop();
+            }
+            other => resolved.push(other),
+        }
+    }
+    resolved
+}
+
+/// Whether every number is finite.
+fn finite(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_paths_resolve_against_the_folder_and_lose_their_dots() {
+        let folder = Path::new("/etc/zeroset/config");
+        assert_eq!(
+            resolve(folder, Path::new("../var/./data")),
+            PathBuf::from("/etc/zeroset/var/data")
+        );
+        assert_eq!(
+            resolve(folder, Path::new("/tmp/zeroset/cmm1")),
+            PathBuf::from("/tmp/zeroset/cmm1")
+        );
+        assert_eq!(
+            resolve(folder, Path::new("parts")),
+            PathBuf::from("/etc/zeroset/config/parts")
+        );
+    }
+
+    #[test]
+    fn the_folder_of_a_bare_file_name_is_the_working_directory() {
+        let here = std::env::current_dir().unwrap().canonicalize().unwrap();
+        assert_eq!(folder_of(Path::new("station.toml")).unwrap(), here);
+    }
+}

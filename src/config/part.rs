@@ -1,0 +1,426 @@
+//! config/parts/NAME.toml: one kind of part. Its instances are copies of the master turned about an axis
+//! (the blades of a propeller), its profiles are the planar sections x = x_mm of the master in the part
+//! frame, each with the nominal point from the drawing where the master's teach scan starts. See the
+//! shipped config/parts/propeller.toml for every key explained.
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::{finite, read_toml, ConfigError};
+use crate::geometry::fit3l::FitMethod;
+
+/// The whole part file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartConfig {
+    pub name: String,
+    pub instances: Instances,
+    /// In increasing x; at least two, since the reference surface interpolates between profiles.
+    pub profiles: Vec<ProfileEntry>,
+    pub scan: ScanSettings,
+    pub reference: ReferenceEntry,
+    pub tolerance: ToleranceEntry,
+}
+
+/// The repeated features of the part: instance k is instance 0 turned `k * step_deg` about the axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Instances {
+    /// In order of turning, e.g. ["A", "B", "C"].
+    pub names: Vec<String>,
+    /// The instance whose scans define the reference; the part frame has it along +x.
+    pub master: String,
+    /// A point of the axis the instances repeat about, part frame.
+    pub axis_point_mm: [f64; 3],
+    /// The axis' direction (any length but zero); the turn is right-handed about it.
+    pub axis_direction: [f64; 3],
+    /// The turn from one instance to the next.
+    pub step_deg: f64,
+}
+
+/// One profile: the master's section by the plane x = `x_mm` (part frame).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileEntry {
+    pub name: String,
+    pub x_mm: f64,
+    /// A nominal point of the master's surface in the profile's plane, where its teach scan starts.
+    pub start_mm: [f64; 3],
+    /// The surface normal at the start as the drawing gives it: the probe comes in along its reverse.
+    pub start_normal: [f64; 3],
+    /// The way the teach scan sets off from the start, in the profile's plane.
+    pub direction: [f64; 3],
+}
+
+/// How profiles are scanned.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScanSettings {
+    /// Distance between scan points (teach) and the longest gap between curve-scan points (inspect).
+    pub step_mm: f64,
+    /// The sphere around the start that ends a teach scan when the probe comes back into it.
+    pub stop_diameter_mm: f64,
+    /// The largest expected distance of a real instance from the taught nominal, along the normal.
+    pub max_deviation_mm: f64,
+    /// The smallest radius of curvature along a profile; the machine slows down for it.
+    pub min_radius_mm: f64,
+    /// A curve scan reports a point wherever the path turns by more than this.
+    pub max_angle_deg: f64,
+}
+
+/// The reference model fitted to the master's profiles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceEntry {
+    pub kind: ReferenceKind,
+    /// The implicit polynomial's degree: even, since an odd degree has no closed zero set.
+    pub degree: usize,
+    pub method: FitMethod,
+    /// Spacing of the nominal points sampled on each fitted profile, which the inspect scans follow.
+    pub nominal_spacing_mm: f64,
+}
+
+/// The kinds of reference model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ReferenceKind {
+    /// An implicit polynomial per profile, blended along x into one surface (seed 003).
+    #[serde(rename = "ip")]
+    ImplicitPolynomial,
+}
+
+/// The band a deviation must lie in for the instance to pass.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToleranceEntry {
+    pub lower_mm: f64,
+    pub upper_mm: f64,
+}
+
+impl PartConfig {
+    /// Reads and checks the file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let config: PartConfig = read_toml(path)?;
+        config.check().map_err(|problem| ConfigError::Invalid {
+            path: path.to_owned(),
+            problem,
+        })?;
+        Ok(config)
+    }
+
+    /// What serde cannot check: references between keys, order, ranges and directions.
+    fn check(&self) -> Result<(), String> {
+        if self.name.trim().is_empty() {
+            return Err("name is empty; name the part as the station is asked for it".into());
+        }
+        self.instances.check()?;
+        if self.profiles.len() < 2 {
+            return Err(format!(
+                "{} [[profiles]]; the reference surface is interpolated between profiles, so give at \
+                 least two",
+                self.profiles.len()
+            ));
+        }
+        let mut names = HashSet::new();
+        for profile in &self.profiles {
+            profile.check()?;
+            if !names.insert(profile.name.as_str()) {
+                return Err(format!(
+                    "two [[profiles]] are named {:?}; give each its own name",
+                    profile.name
+                ));
+            }
+        }
+        for pair in self.profiles.windows(2) {
+            if pair[1].x_mm <= pair[0].x_mm {
+                return Err(format!(
+                    "profile {} (x = {} mm) follows profile {} (x = {} mm); list the profiles in \
+                     increasing x, each at its own x",
+                    pair[1].name, pair[1].x_mm, pair[0].name, pair[0].x_mm
+                ));
+            }
+        }
+        self.scan.check()?;
+        self.reference.check()?;
+        let tolerance = &self.tolerance;
+        if !(finite(&[tolerance.lower_mm, tolerance.upper_mm])
+            && tolerance.lower_mm < tolerance.upper_mm)
+        {
+            return Err(format!(
+                "[tolerance] lower_mm = {} must be below upper_mm = {}",
+                tolerance.lower_mm, tolerance.upper_mm
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Whether a direction can be normalised.
+fn usable_direction(v: [f64; 3]) -> bool {
+    finite(&v) && Vector3::from(v).norm() > 1e-12
+}
+
+impl Instances {
+    fn check(&self) -> Result<(), String> {
+        if self.names.is_empty() {
+            return Err("[instances] names is empty; list at least the master".into());
+        }
+        let mut seen = HashSet::new();
+        if let Some(twice) = self.names.iter().find(|name| !seen.insert(name.as_str())) {
+            return Err(format!(
+                "[instances] names lists {twice:?} twice; give each instance its own name"
+            ));
+        }
+        if !self.names.contains(&self.master) {
+            return Err(format!(
+                "[instances] master = {:?} is not among names = {:?}",
+                self.master, self.names
+            ));
+        }
+        if !finite(&self.axis_point_mm) || !usable_direction(self.axis_direction) {
+            return Err(format!(
+                "[instances] needs a finite axis_point_mm and a non-zero axis_direction (got {:?} and \
+                 {:?})",
+                self.axis_point_mm, self.axis_direction
+            ));
+        }
+        if !self.step_deg.is_finite() || (self.names.len() > 1 && self.step_deg == 0.0) {
+            return Err(format!(
+                "[instances] step_deg = {} would put every instance in the same place; give the turn \
+                 from one instance to the next",
+                self.step_deg
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl ProfileEntry {
+    /// The plane's normal is x: the start must lie in the plane, and the probe and the scan must move in it.
+    fn check(&self) -> Result<(), String> {
+        let name = &self.name;
+        if !finite(&self.start_mm) || !self.x_mm.is_finite() {
+            return Err(format!(
+                "profile {name}: x_mm and start_mm must be finite numbers"
+            ));
+        }
+        if (self.start_mm[0] - self.x_mm).abs() > 1e-6 {
+            return Err(format!(
+                "profile {name}: start_mm {:?} is not in the profile's plane x = {} mm; give a start \
+                 point with x = {}",
+                self.start_mm, self.x_mm, self.x_mm
+            ));
+        }
+        for (key, v) in [
+            ("start_normal", self.start_normal),
+            ("direction", self.direction),
+        ] {
+            if !usable_direction(v) || v[0].abs() > 1e-9 * Vector3::from(v).norm() {
+                return Err(format!(
+                    "profile {name}: {key} = {v:?} must be a non-zero direction in the profile's plane \
+                     (its x component 0)"
+                ));
+            }
+        }
+        let (normal, direction) = (
+            Vector3::from(self.start_normal).normalize(),
+            Vector3::from(self.direction).normalize(),
+        );
+        if normal.cross(&direction).norm() < 1e-6 {
+            return Err(format!(
+                "profile {name}: direction {:?} runs along start_normal {:?}; give a direction along the \
+                 surface",
+                self.direction, self.start_normal
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl ScanSettings {
+    fn check(&self) -> Result<(), String> {
+        let positive = [
+            ("step_mm", self.step_mm),
+            ("stop_diameter_mm", self.stop_diameter_mm),
+            ("max_deviation_mm", self.max_deviation_mm),
+            ("min_radius_mm", self.min_radius_mm),
+        ];
+        if let Some((key, value)) = positive
+            .iter()
+            .find(|(_, value)| !(*value > 0.0 && value.is_finite()))
+        {
+            return Err(format!("[scan] {key} = {value} must be above zero"));
+        }
+        if !(self.max_angle_deg > 0.0 && self.max_angle_deg < 180.0) {
+            return Err(format!(
+                "[scan] max_angle_deg = {} must lie between 0 and 180 degrees",
+                self.max_angle_deg
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl ReferenceEntry {
+    fn check(&self) -> Result<(), String> {
+        if self.degree < 2 || self.degree % 2 == 1 {
+            return Err(format!(
+                "[reference] degree = {}: a closed profile needs an even degree of at least 2",
+                self.degree
+            ));
+        }
+        if !(self.nominal_spacing_mm > 0.0 && self.nominal_spacing_mm.is_finite()) {
+            return Err(format!(
+                "[reference] nominal_spacing_mm = {} must be above zero",
+                self.nominal_spacing_mm
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    use nalgebra::{Point2, Point3};
+    use zeroset_sim::config::{PartSpec, SimConfig};
+    use zeroset_sim::part::curve::SampledCurve;
+    use zeroset_sim::part::propeller::Propeller;
+
+    fn repo(path: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+    }
+
+    fn shipped() -> PartConfig {
+        PartConfig::load(&repo("config/parts/propeller.toml")).unwrap()
+    }
+
+    /// The simulator's ground truth of the propeller the part file describes.
+    fn simulated_propeller() -> Propeller {
+        let sim = SimConfig::load(&repo("config/sims/propeller.toml")).unwrap();
+        let PartSpec::Propeller(spec) = &sim.parts["propeller"] else {
+            panic!("config/sims/propeller.toml holds a propeller");
+        };
+        Propeller::new(spec.clone()).unwrap()
+    }
+
+    /// Why the shipped file, edited by `edit`, is refused.
+    fn refusal(edit: impl FnOnce(&mut PartConfig)) -> String {
+        let mut config = shipped();
+        edit(&mut config);
+        config.check().unwrap_err()
+    }
+
+    #[test]
+    fn the_shipped_propeller_has_three_blades_and_five_profiles() {
+        let part = shipped();
+        assert_eq!(part.name, "propeller");
+        assert_eq!(part.instances.names, ["A", "B", "C"]);
+        assert_eq!(part.instances.master, "A");
+        assert_eq!(part.instances.step_deg, 120.0);
+        let xs: Vec<f64> = part.profiles.iter().map(|p| p.x_mm).collect();
+        assert_eq!(xs, [100.0, 200.0, 300.0, 400.0, 500.0]);
+        let names: Vec<&str> = part.profiles.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["r100", "r200", "r300", "r400", "r500"]);
+        assert_eq!(part.reference.degree, 8);
+        assert_eq!(part.reference.method, FitMethod::Orthogonal);
+        assert_eq!(part.reference.kind, ReferenceKind::ImplicitPolynomial);
+        assert_eq!(
+            (part.tolerance.lower_mm, part.tolerance.upper_mm),
+            (-0.1, 0.1)
+        );
+    }
+
+    /// The drawing's start points were computed once from the simulator's blade A; if the simulated
+    /// propeller changes, this says which numbers to write again.
+    #[test]
+    fn every_start_point_lies_on_the_simulated_top_of_blade_a() {
+        let truth = simulated_propeller();
+        for profile in shipped().profiles {
+            let frame = truth.section_frame(0, profile.x_mm);
+            let section = SampledCurve::new(truth.section_curve(0, profile.x_mm));
+            let local = frame.local(&Point3::from(profile.start_mm));
+            let nearest = section.nearest(&Point2::new(local.x, local.y));
+            assert!(
+                nearest.signed_distance.abs() < 0.05,
+                "profile {}: start {:?} is {:.4} mm off blade A",
+                profile.name,
+                profile.start_mm,
+                nearest.signed_distance
+            );
+            // On the top: the outward normal there has an upward component.
+            assert!(
+                nearest.on_curve.normal.y > 0.5,
+                "profile {}: not on the top surface",
+                profile.name
+            );
+        }
+    }
+
+    #[test]
+    fn a_misspelt_key_names_the_file_and_the_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("propeller.toml");
+        let text = std::fs::read_to_string(repo("config/parts/propeller.toml")).unwrap();
+        std::fs::write(&path, text.replace("step_deg", "step_degrees")).unwrap();
+        let message = PartConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.starts_with(&path.display().to_string()),
+            "{message}"
+        );
+        assert!(
+            message.contains("unknown field `step_degrees`"),
+            "{message}"
+        );
+        std::fs::write(
+            &path,
+            text.replace("kind = \"ip\"", "kind = \"supershape\""),
+        )
+        .unwrap();
+        let message = PartConfig::load(&path).unwrap_err().to_string();
+        assert!(message.contains("supershape"), "{message}");
+    }
+
+    #[test]
+    fn inconsistent_parts_are_refused_with_the_fix() {
+        let message = refusal(|c| c.instances.master = "D".into());
+        assert!(
+            message.contains("master = \"D\" is not among names"),
+            "{message}"
+        );
+
+        let message = refusal(|c| c.profiles.swap(1, 2));
+        assert!(
+            message.contains("profile r200 (x = 200 mm) follows profile r300"),
+            "{message}"
+        );
+
+        let message = refusal(|c| c.profiles.truncate(1));
+        assert!(message.contains("give at least two"), "{message}");
+
+        let message = refusal(|c| c.profiles[0].start_normal = [0.0, 0.0, 0.0]);
+        assert!(message.contains("profile r100: start_normal"), "{message}");
+
+        let message = refusal(|c| c.profiles[2].start_mm[0] = 301.0);
+        assert!(
+            message.contains("not in the profile's plane x = 300 mm"),
+            "{message}"
+        );
+
+        let message = refusal(|c| c.profiles[3].direction = [0.0, 0.0, -2.0]);
+        assert!(message.contains("profile r400: direction"), "{message}");
+
+        let message = refusal(|c| c.reference.degree = 7);
+        assert!(message.contains("even degree"), "{message}");
+
+        let message = refusal(|c| c.tolerance.lower_mm = 0.2);
+        assert!(message.contains("must be below upper_mm"), "{message}");
+
+        let message = refusal(|c| c.instances.names.push("A".into()));
+        assert!(message.contains("lists \"A\" twice"), "{message}");
+    }
+}

@@ -1,0 +1,364 @@
+//! config/station.toml: the machines the daemon drives, the probe and its speeds, the safety limits, where
+//! data, reports and logs go, the control socket, the folder of part files, and where the part sits on the
+//! table. See the shipped config/station.toml for every key explained.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::{finite, folder_of, read_toml, resolve, ConfigError};
+
+/// The whole station file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StationConfig {
+    /// The station's name, for reports.
+    pub name: String,
+    /// At least one; names unique.
+    pub machines: Vec<MachineEntry>,
+    pub probe: ProbeSettings,
+    pub safety: Safety,
+    /// Absolute after [`StationConfig::load`].
+    pub folders: Folders,
+    pub control: Control,
+    /// The folder of part files, `NAME.toml` each; absolute after [`StationConfig::load`].
+    pub parts: PathBuf,
+    /// Where the part frame lies in machine coordinates (default: they coincide), so that a fixture
+    /// offset is one change here rather than in every part file.
+    #[serde(default)]
+    pub part_to_machine: Pose,
+}
+
+/// One CMM and the line it is reached on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineEntry {
+    pub name: String,
+    /// A serial device (`/dev/ttyUSB0`) or a pseudo-terminal's path (the simulator's, or a link to it).
+    pub port: PathBuf,
+    /// Bits per second of a serial line; absent for a pseudo-terminal, which has no speed.
+    #[serde(default)]
+    pub baud: Option<u32>,
+    /// How long a command may wait for its `&`.
+    pub ack_timeout_s: f64,
+    /// The longest silence within a transaction: longer than the slowest move (homing).
+    pub reply_timeout_s: f64,
+}
+
+/// The probe the station scans with, and its speeds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSettings {
+    /// The tool's name on the machine, as `ChangeTool` takes it.
+    pub tool: String,
+    pub travel_mm_s: f64,
+    pub probing_mm_s: f64,
+    pub scanning_mm_s: f64,
+}
+
+/// Limits the station keeps to so that it does not hit the part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Safety {
+    /// The height (part frame, z) of free travel between profiles.
+    pub clearance_z_mm: f64,
+    /// A tool whose ball is bigger than this is refused.
+    pub max_ball_radius_mm: f64,
+}
+
+/// Where the station writes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Folders {
+    /// Raw scans and reference models.
+    pub data: PathBuf,
+    /// One folder per inspected part.
+    pub reports: PathBuf,
+    pub logs: PathBuf,
+}
+
+/// The control API.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Control {
+    /// The Unix socket the daemon listens on.
+    pub socket: PathBuf,
+}
+
+/// A rigid placement on the table: a shift and a turn about the machine's z axis. Every key defaults
+/// to zero, so `{ z_mm = 12.5 }` is a fixture 12.5 mm high.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Pose {
+    pub x_mm: f64,
+    pub y_mm: f64,
+    pub z_mm: f64,
+    pub rot_z_deg: f64,
+}
+
+impl Pose {
+    /// The turn about z first, then the shift.
+    pub fn isometry(&self) -> Isometry3<f64> {
+        Isometry3::from_parts(
+            Translation3::new(self.x_mm, self.y_mm, self.z_mm),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.rot_z_deg.to_radians()),
+        )
+    }
+}
+
+impl StationConfig {
+    /// Reads and checks the file; relative paths become absolute against its folder.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let mut config: StationConfig = read_toml(path)?;
+        config.check().map_err(|problem| ConfigError::Invalid {
+            path: path.to_owned(),
+            problem,
+        })?;
+        let folder = folder_of(path)?;
+        for relative in [
+            &mut config.folders.data,
+            &mut config.folders.reports,
+            &mut config.folders.logs,
+            &mut config.control.socket,
+            &mut config.parts,
+        ] {
+            *relative = resolve(&folder, relative);
+        }
+        for machine in &mut config.machines {
+            machine.port = resolve(&folder, &machine.port);
+        }
+        Ok(config)
+    }
+
+    /// The file of the part named `part`.
+    pub fn part_path(&self, part: &str) -> PathBuf {
+        self.parts.join(format!("{part}.toml"))
+    }
+
+    /// What serde cannot check: counts, uniqueness and ranges.
+    fn check(&self) -> Result<(), String> {
+        if self.name.trim().is_empty() {
+            return Err("name is empty; give the station a name for its reports".into());
+        }
+        if self.machines.is_empty() {
+            return Err("no [[machines]]; the station needs at least one".into());
+        }
+        let mut names = HashSet::new();
+        for machine in &self.machines {
+            machine.check()?;
+            if !names.insert(machine.name.as_str()) {
+                return Err(format!(
+                    "two [[machines]] are named {:?}; give each its own name",
+                    machine.name
+                ));
+            }
+        }
+        self.probe.check()?;
+        let safety = &self.safety;
+        if !(safety.clearance_z_mm.is_finite()
+            && safety.max_ball_radius_mm > 0.0
+            && safety.max_ball_radius_mm.is_finite())
+        {
+            return Err(format!(
+                "[safety] needs a finite clearance_z_mm and max_ball_radius_mm above zero \
+                 (got {} and {})",
+                safety.clearance_z_mm, safety.max_ball_radius_mm
+            ));
+        }
+        let pose = &self.part_to_machine;
+        if !finite(&[pose.x_mm, pose.y_mm, pose.z_mm, pose.rot_z_deg]) {
+            return Err(format!(
+                "part_to_machine {pose:?} has a value that is not a finite number"
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl MachineEntry {
+    fn check(&self) -> Result<(), String> {
+        if self.name.trim().is_empty() {
+            return Err("a [[machines]] entry has an empty name".into());
+        }
+        let positive = |value: f64| value > 0.0 && value.is_finite();
+        if !(positive(self.ack_timeout_s) && positive(self.reply_timeout_s)) {
+            return Err(format!(
+                "machine {}: ack_timeout_s and reply_timeout_s must be above zero (got {} and {})",
+                self.name, self.ack_timeout_s, self.reply_timeout_s
+            ));
+        }
+        if self.baud == Some(0) {
+            return Err(format!(
+                "machine {}: baud = 0; give the line's speed, or leave baud out for a pseudo-terminal",
+                self.name
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl ProbeSettings {
+    fn check(&self) -> Result<(), String> {
+        if self.tool.trim().is_empty() {
+            return Err("[probe] tool is empty; name the tool as the machine knows it".into());
+        }
+        let speeds = [self.travel_mm_s, self.probing_mm_s, self.scanning_mm_s];
+        if !speeds.iter().all(|s| *s > 0.0 && s.is_finite()) {
+            return Err(format!(
+                "[probe] speeds must be above zero (got travel {}, probing {}, scanning {} mm/s)",
+                self.travel_mm_s, self.probing_mm_s, self.scanning_mm_s
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point3;
+
+    fn shipped() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("config/station.toml")
+    }
+
+    /// The shipped file with `edit` applied to its text, written as `station.toml` in a temporary folder.
+    fn edited(edit: impl FnOnce(String) -> String) -> (tempfile::TempDir, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("station.toml");
+        let text = std::fs::read_to_string(shipped()).unwrap();
+        std::fs::write(&path, edit(text)).unwrap();
+        (dir, path)
+    }
+
+    #[test]
+    fn the_shipped_station_loads_with_absolute_folders_beside_config() {
+        let config = StationConfig::load(&shipped()).unwrap();
+        let repo = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .canonicalize()
+            .unwrap();
+        assert_eq!(config.machines.len(), 1);
+        let cmm1 = &config.machines[0];
+        assert_eq!(
+            (cmm1.name.as_str(), cmm1.port.as_path(), cmm1.baud),
+            ("cmm1", Path::new("/tmp/zeroset/cmm1"), None)
+        );
+        assert_eq!(config.probe.tool, "Probe1");
+        let probe = &config.probe;
+        assert_eq!(
+            (probe.travel_mm_s, probe.probing_mm_s, probe.scanning_mm_s),
+            (100.0, 5.0, 20.0)
+        );
+        assert_eq!(config.safety.clearance_z_mm, 150.0);
+        assert_eq!(config.folders.data, repo.join("var/zeroset/data"));
+        assert_eq!(config.folders.reports, repo.join("var/zeroset/reports"));
+        assert_eq!(config.folders.logs, repo.join("var/zeroset/logs"));
+        assert_eq!(config.control.socket, repo.join("var/zeroset/zeroset.sock"));
+        assert_eq!(
+            config.part_path("propeller"),
+            repo.join("config/parts/propeller.toml")
+        );
+        assert_eq!(config.part_to_machine.isometry(), Isometry3::identity());
+    }
+
+    #[test]
+    fn a_misspelt_key_is_named_with_the_file_and_its_line() {
+        let (_dir, path) = edited(|t| t.replace("clearance_z_mm", "clearence_z_mm"));
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.starts_with(&path.display().to_string()),
+            "{message}"
+        );
+        assert!(
+            message.contains("unknown field `clearence_z_mm`"),
+            "{message}"
+        );
+        assert!(message.contains("line"), "{message}");
+    }
+
+    #[test]
+    fn a_missing_key_is_named_with_the_file() {
+        let (_dir, path) = edited(|t| {
+            t.lines()
+                .filter(|line| !line.starts_with("scanning_mm_s"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        });
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.starts_with(&path.display().to_string()),
+            "{message}"
+        );
+        assert!(
+            message.contains("missing field `scanning_mm_s`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn relative_paths_resolve_against_the_files_own_folder() {
+        let (dir, path) = edited(|t| t.replace("\"/tmp/zeroset/cmm1\"", "\"ports/cmm1\""));
+        let config = StationConfig::load(&path).unwrap();
+        let folder = dir.path().canonicalize().unwrap();
+        assert_eq!(config.machines[0].port, folder.join("ports/cmm1"));
+        assert_eq!(config.parts, folder.join("parts"));
+        assert_eq!(
+            config.folders.data,
+            folder.parent().unwrap().join("var/zeroset/data")
+        );
+    }
+
+    #[test]
+    fn duplicate_machine_names_and_bad_numbers_are_refused_with_the_fix() {
+        let twice = |t: String| {
+            let machine = t
+                .split("[[machines]]")
+                .nth(1)
+                .and_then(|rest| rest.split("\n\n").next())
+                .map(str::to_owned)
+                .unwrap();
+            format!("{t}\n[[machines]]{machine}\n")
+        };
+        let (_dir, path) = edited(twice);
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("two [[machines]] are named \"cmm1\""),
+            "{message}"
+        );
+
+        let (_dir, path) = edited(|t| t.replace("scanning_mm_s = 20.0", "scanning_mm_s = 0.0"));
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(message.contains("speeds must be above zero"), "{message}");
+    }
+
+    #[test]
+    fn a_fixture_offset_turns_then_shifts() {
+        let pose = Pose {
+            x_mm: 10.0,
+            y_mm: -5.0,
+            z_mm: 12.5,
+            rot_z_deg: 90.0,
+        };
+        let moved = pose.isometry() * Point3::new(100.0, 0.0, 0.0);
+        assert!(
+            (moved - Point3::new(10.0, 95.0, 12.5)).norm() < 1e-12,
+            "{moved}"
+        );
+        let (_dir, path) = edited(|t| {
+            t.replace(
+                "part_to_machine = { x_mm = 0.0, y_mm = 0.0, z_mm = 0.0, rot_z_deg = 0.0 }",
+                "part_to_machine = { z_mm = 12.5 }",
+            )
+        });
+        let config = StationConfig::load(&path).unwrap();
+        assert_eq!(
+            config.part_to_machine,
+            Pose {
+                z_mm: 12.5,
+                ..Pose::default()
+            }
+        );
+    }
+}

@@ -1,0 +1,250 @@
+//! The plan of a part: its instances x its profiles, and the machine scan of each. Teach scans the master's
+//! profiles with an in-plane scan of unknown shape that starts from the drawing's nominal point; inspect scans
+//! every instance's profiles along the curve taught on the master. Profiles, start points and taught nominals
+//! are given in the part frame of the master; the plan moves them onto each instance and into machine
+//! coordinates, so the scheduler and the machine workers only ever see machine coordinates.
+
+use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
+
+use crate::analysis::NominalPoint;
+use crate::config::{PartConfig, ProfileEntry, ReferenceEntry, ScanSettings, ToleranceEntry};
+
+/// A teach scan stops in a sphere centred this far off its start along the start normal: where the ball
+/// centre of the station's 1 mm probe sits when it touches the start, so the scan ends as it comes back
+/// round; the sphere's radius absorbs other balls.
+const STOP_CENTRE_OFF_START_MM: f64 = 1.0;
+
+/// A teach scan's heading is given as a point this far from its start along the profile's direction (I++
+/// only needs a point apart from the start).
+const HEADING_POINT_MM: f64 = 10.0;
+
+/// One scan of the plan: an instance's profile (indices into [`Plan::instance_names`] and
+/// [`Plan::profile_names`]). Ordered by instance, then profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct ProfileKey {
+    pub instance: usize,
+    pub profile: usize,
+}
+
+/// A part's scans, in machine coordinates.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    part: PartConfig,
+    master: usize,
+    /// Per instance: the master's part frame moved onto the instance, in machine coordinates.
+    placements: Vec<Isometry3<f64>>,
+}
+
+impl Plan {
+    /// The plan of a loaded part (whose master is among its instances, as [`PartConfig::load`] checks),
+    /// placed on the table by `part_to_machine`.
+    pub fn new(part: &PartConfig, part_to_machine: Isometry3<f64>) -> Plan {
+        let instances = &part.instances;
+        let master = instances
+            .names
+            .iter()
+            .position(|name| *name == instances.master)
+            .expect("PartConfig::load checks that the master is among the instances");
+        let axis = Unit::new_normalize(Vector3::from(instances.axis_direction));
+        let axis_point = Point3::from(instances.axis_point_mm);
+        let placements = (0..instances.names.len())
+            .map(|instance| {
+                let steps = instance as f64 - master as f64;
+                let turn = UnitQuaternion::from_axis_angle(
+                    &axis,
+                    (steps * instances.step_deg).to_radians(),
+                );
+                part_to_machine * Isometry3::rotation_wrt_point(turn, axis_point)
+            })
+            .collect();
+        Plan {
+            part: part.clone(),
+            master,
+            placements,
+        }
+    }
+
+    /// The part's name.
+    pub fn part(&self) -> &str {
+        &self.part.name
+    }
+
+    pub fn instance_names(&self) -> &[String] {
+        &self.part.instances.names
+    }
+
+    /// The master's index among [`Plan::instance_names`].
+    pub fn master(&self) -> usize {
+        self.master
+    }
+
+    pub fn profile_names(&self) -> Vec<&str> {
+        self.part.profiles.iter().map(|p| p.name.as_str()).collect()
+    }
+
+    /// The x of the profile's plane in the part frame, mm.
+    pub fn profile_x(&self, profile: usize) -> f64 {
+        self.part.profiles[profile].x_mm
+    }
+
+    /// A scan as operators and logs name it: "instance B, profile r300 (x = 300 mm)".
+    pub fn describe(&self, key: ProfileKey) -> String {
+        let profile = &self.part.profiles[key.profile];
+        format!(
+            "instance {}, profile {} (x = {} mm)",
+            self.part.instances.names[key.instance], profile.name, profile.x_mm
+        )
+    }
+
+    /// The master's profiles, in increasing x.
+    pub fn teach_scans(&self) -> Vec<ProfileKey> {
+        (0..self.part.profiles.len())
+            .map(|profile| ProfileKey {
+                instance: self.master,
+                profile,
+            })
+            .collect()
+    }
+
+    /// Every instance's profiles, instance by instance.
+    pub fn inspect_scans(&self) -> Vec<ProfileKey> {
+        (0..self.placements.len())
+            .flat_map(|instance| {
+                (0..self.part.profiles.len()).map(move |profile| ProfileKey { instance, profile })
+            })
+            .collect()
+    }
+
+    /// Rigid transform from the master's part frame to instance `instance` in machine coordinates
+    /// (part_to_machine * the turn about the instances' axis).
+    pub fn instance_to_machine(&self, instance: usize) -> Isometry3<f64> {
+        self.placements[instance]
+    }
+
+    /// A point in machine coordinates where the profile's scan starts (for ordering scans to cut travel):
+    /// the first point of its curve scan when the taught nominals are given, else the drawing's start.
+    pub fn scan_start(&self, key: ProfileKey, nominals: Option<&[NominalPoint]>) -> Point3<f64> {
+        let placement = self.instance_to_machine(key.instance);
+        match nominals {
+            Some(nominals) if !nominals.is_empty() => {
+                placement * Point3::from(nominals[self.upmost(key, nominals)].point)
+            }
+            _ => placement * Point3::from(self.profile(key).start_mm),
+        }
+    }
+
+    /// The in-plane scan of a profile of unknown shape (teach): it probes the drawing's start along
+    /// -start_normal, follows the section x = x_mm heading along `direction`, and stops when it comes back
+    /// to the start; everything moved onto `key.instance` in machine coordinates.
+    pub fn in_plane_scan(&self, key: ProfileKey) -> InPlaneScan {
+        let placement = self.instance_to_machine(key.instance);
+        let profile = self.profile(key);
+        let start = Point3::from(profile.start_mm);
+        let normal = Vector3::from(profile.start_normal).normalize();
+        let heading = Vector3::from(profile.direction).normalize();
+        let point = |p: Point3<f64>| xyz(&(placement * p).coords);
+        let direction = |v: Vector3<f64>| xyz(&(placement * v));
+        InPlaneScan {
+            start: point(start),
+            start_normal: direction(normal),
+            plane_normal: direction(Vector3::x()),
+            direction: point(start + heading * HEADING_POINT_MM),
+            step: self.part.scan.step_mm,
+            end: point(start + normal * STOP_CENTRE_OFF_START_MM),
+            stop_diameter: self.part.scan.stop_diameter_mm,
+            passes: 1,
+            end_normal: direction(normal),
+        }
+    }
+
+    /// The curve scan of any instance's profile along the nominals taught on the master (part frame),
+    /// moved onto the instance in machine coordinates. Closed, and starting at the nominal whose normal
+    /// points most nearly up (+z in machine coordinates), so the approach from the clearance height above
+    /// it is a straight vertical move.
+    pub fn curve_scan(&self, key: ProfileKey, nominals: &[NominalPoint]) -> CurveScan {
+        let placement = self.instance_to_machine(key.instance);
+        let first = if nominals.is_empty() {
+            0
+        } else {
+            self.upmost(key, nominals)
+        };
+        let nominals = nominals[first..]
+            .iter()
+            .chain(&nominals[..first])
+            .map(|n| Nominal {
+                point: xyz(&(placement * Point3::from(n.point)).coords),
+                normal: xyz(&(placement * Vector3::from(n.normal)).normalize()),
+            })
+            .collect();
+        let scan = &self.part.scan;
+        CurveScan {
+            closed: true,
+            nominals,
+            max_deviation: scan.max_deviation_mm,
+            min_radius: scan.min_radius_mm,
+            density: Density::Spacing {
+                max_distance: scan.step_mm,
+                max_angle: scan.max_angle_deg.to_radians(),
+            },
+        }
+    }
+
+    /// The index into `remaining` of the scan to do next from `from`: the one whose start is nearest.
+    /// Travel at the clearance height is horizontal, so horizontal distances are compared; ties go to
+    /// the first in [`ProfileKey`] order, so the choice does not depend on the order of `remaining`.
+    pub fn nearest(
+        &self,
+        remaining: &[ProfileKey],
+        from: Point3<f64>,
+        starts: impl Fn(ProfileKey) -> Point3<f64>,
+    ) -> Option<usize> {
+        remaining
+            .iter()
+            .enumerate()
+            .map(|(index, key)| {
+                let start = starts(*key);
+                ((start.x - from.x).hypot(start.y - from.y), *key, index)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+            .map(|(_, _, index)| index)
+    }
+
+    pub fn scan_settings(&self) -> &ScanSettings {
+        &self.part.scan
+    }
+
+    pub fn reference_settings(&self) -> &ReferenceEntry {
+        &self.part.reference
+    }
+
+    pub fn tolerance(&self) -> &ToleranceEntry {
+        &self.part.tolerance
+    }
+
+    fn profile(&self, key: ProfileKey) -> &ProfileEntry {
+        &self.part.profiles[key.profile]
+    }
+
+    /// The index of the non-empty `nominals`' point whose normal, on the instance in machine coordinates,
+    /// points most nearly up (the first of equals).
+    fn upmost(&self, key: ProfileKey, nominals: &[NominalPoint]) -> usize {
+        let placement = self.instance_to_machine(key.instance);
+        let upness = |n: &NominalPoint| (placement * Vector3::from(n.normal)).normalize().z;
+        (1..nominals.len()).fold(0, |best, i| {
+            if upness(&nominals[i]) > upness(&nominals[best]) {
+                i
+            } else {
+                best
+            }
+        })
+    }
+}
+
+fn xyz(v: &Vector3<f64>) -> Xyz {
+    Xyz::new(v.x, v.y, v.z)
+}
+
+#[cfg(test)]
+mod tests;

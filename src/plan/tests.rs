@@ -1,0 +1,293 @@
+use std::path::Path;
+
+use nalgebra::{Point2, Point3};
+use zeroset_sim::config::{PartSpec, SimConfig};
+use zeroset_sim::part::curve::SampledCurve;
+use zeroset_sim::part::propeller::Propeller;
+
+use super::*;
+use crate::config::Pose;
+
+const TURN_120: (f64, f64) = (-0.5, 0.866_025_403_784_438_6);
+
+fn propeller_part() -> PartConfig {
+    PartConfig::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/parts/propeller.toml"))
+        .unwrap()
+}
+
+fn plan() -> Plan {
+    Plan::new(&propeller_part(), Isometry3::identity())
+}
+
+fn simulated_propeller() -> Propeller {
+    let sim =
+        SimConfig::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sims/propeller.toml"))
+            .unwrap();
+    let PartSpec::Propeller(spec) = &sim.parts["propeller"] else {
+        panic!("config/sims/propeller.toml holds a propeller");
+    };
+    Propeller::new(spec.clone()).unwrap()
+}
+
+fn key(instance: usize, profile: usize) -> ProfileKey {
+    ProfileKey { instance, profile }
+}
+
+fn point(x: &Xyz) -> Point3<f64> {
+    Point3::new(x.x, x.y, x.z)
+}
+
+fn assert_near(actual: &Xyz, expected: [f64; 3], what: &str) {
+    let off = (point(actual) - Point3::from(expected)).norm();
+    assert!(off < 1e-9, "{what}: {actual:?}, expected {expected:?}");
+}
+
+#[test]
+fn names_scans_and_descriptions() {
+    let plan = plan();
+    assert_eq!(plan.part(), "propeller");
+    assert_eq!(plan.instance_names(), ["A", "B", "C"]);
+    assert_eq!(plan.master(), 0);
+    assert_eq!(
+        plan.profile_names(),
+        ["r100", "r200", "r300", "r400", "r500"]
+    );
+    assert_eq!(plan.profile_x(2), 300.0);
+    assert_eq!(
+        plan.describe(key(1, 2)),
+        "instance B, profile r300 (x = 300 mm)"
+    );
+    let teach = plan.teach_scans();
+    assert_eq!(teach, (0..5).map(|p| key(0, p)).collect::<Vec<_>>());
+    let inspect = plan.inspect_scans();
+    assert_eq!(inspect.len(), 15);
+    assert_eq!(
+        (inspect[0], inspect[5], inspect[14]),
+        (key(0, 0), key(1, 0), key(2, 4))
+    );
+    assert_eq!(plan.scan_settings().step_mm, 1.0);
+    assert_eq!(plan.reference_settings().degree, 8);
+    assert_eq!(plan.tolerance().upper_mm, 0.1);
+}
+
+#[test]
+fn blade_b_is_blade_a_turned_120_degrees_about_the_hub_axis() {
+    let plan = plan();
+    // r300 of blade A starts at (300, 0, 13.32): on blade B that is 300 mm along 120 degrees.
+    let a = plan.scan_start(key(0, 2), None);
+    assert!((a - Point3::new(300.0, 0.0, 13.32)).norm() < 1e-12, "{a}");
+    let b = plan.scan_start(key(1, 2), None);
+    let (cos, sin) = TURN_120;
+    assert!(
+        (b - Point3::new(300.0 * cos, 300.0 * sin, 13.32)).norm() < 1e-9,
+        "{b}"
+    );
+    assert!((b - Point3::new(-150.0, 259.807_621_135_331_6, 13.32)).norm() < 1e-9);
+    // Blade C is 240 degrees round: the mirror of B in the xz plane.
+    let c = plan.scan_start(key(2, 2), None);
+    assert!(
+        (c - Point3::new(-150.0, -259.807_621_135_331_6, 13.32)).norm() < 1e-9,
+        "{c}"
+    );
+}
+
+#[test]
+fn a_fixture_offset_moves_every_instance_after_the_turn() {
+    let part_to_machine = Pose {
+        x_mm: 10.0,
+        y_mm: -5.0,
+        z_mm: 12.5,
+        rot_z_deg: 90.0,
+    };
+    let plan = Plan::new(&propeller_part(), part_to_machine.isometry());
+    // A at (300, 0): the fixture turns it to (0, 300) and shifts it.
+    let a = plan.scan_start(key(0, 2), None);
+    assert!((a - Point3::new(10.0, 295.0, 25.82)).norm() < 1e-9, "{a}");
+    // B at 120 degrees, the fixture turns it to 210 degrees.
+    let b = plan.scan_start(key(1, 2), None);
+    let at_210 = Point3::new(-259.807_621_135_331_6 + 10.0, -150.0 - 5.0, 25.82);
+    assert!((b - at_210).norm() < 1e-9, "{b}");
+}
+
+#[test]
+fn a_master_other_than_the_first_instance_stays_in_place() {
+    let mut part = propeller_part();
+    part.instances.master = "B".into();
+    let plan = Plan::new(&part, Isometry3::identity());
+    assert_eq!(plan.master(), 1);
+    assert_eq!(plan.instance_to_machine(1), Isometry3::identity());
+    // A comes before B: it is B's frame turned back by one step.
+    let a = plan.scan_start(key(0, 0), None);
+    let (cos, sin) = TURN_120;
+    assert!(
+        (a - Point3::new(100.0 * cos, -100.0 * sin, 23.98)).norm() < 1e-9,
+        "{a}"
+    );
+}
+
+#[test]
+fn instances_turn_about_the_configured_axis_point() {
+    let mut part = propeller_part();
+    part.instances.axis_point_mm = [10.0, 0.0, 0.0];
+    let plan = Plan::new(&part, Isometry3::identity());
+    // r100 starts 90 mm from the axis: blade B's start is 90 mm along 120 degrees from (10, 0).
+    let b = plan.scan_start(key(1, 0), None);
+    let (cos, sin) = TURN_120;
+    assert!(
+        (b - Point3::new(10.0 + 90.0 * cos, 90.0 * sin, 23.98)).norm() < 1e-9,
+        "{b}"
+    );
+}
+
+/// The teach scan of blade A at radius 200, as the end-to-end test's scan that the simulator completes:
+/// started on the surface from above, in the plane x = 200, heading along +y, ending where it began.
+#[test]
+fn the_teach_scan_of_blade_a_starts_on_the_simulated_surface_in_the_plane_x() {
+    let scan = plan().in_plane_scan(key(0, 1));
+    let truth = simulated_propeller();
+    let frame = truth.section_frame(0, 200.0);
+    let section = SampledCurve::new(truth.section_curve(0, 200.0));
+    let local = frame.local(&point(&scan.start));
+    assert!(
+        local.z.abs() < 1e-12,
+        "off the plane x = 200: {:?}",
+        scan.start
+    );
+    let off = section
+        .nearest(&Point2::new(local.x, local.y))
+        .signed_distance;
+    assert!(off.abs() < 0.05, "{off} mm off blade A");
+    assert_near(&scan.start, [200.0, 0.0, 16.34], "start");
+    assert_near(&scan.start_normal, [0.0, 0.0, 1.0], "start normal");
+    assert_near(&scan.plane_normal, [1.0, 0.0, 0.0], "plane normal");
+    assert_near(&scan.direction, [200.0, 10.0, 16.34], "direction point");
+    assert_near(&scan.end, [200.0, 0.0, 17.34], "end");
+    assert_near(&scan.end_normal, [0.0, 0.0, 1.0], "end normal");
+    assert_eq!((scan.step, scan.stop_diameter, scan.passes), (1.0, 3.0, 1));
+}
+
+#[test]
+fn the_teach_scan_of_another_instance_turns_its_plane_with_it() {
+    let scan = plan().in_plane_scan(key(1, 1));
+    let (cos, sin) = TURN_120;
+    assert_near(&scan.plane_normal, [cos, sin, 0.0], "plane normal");
+    assert_near(&scan.start, [200.0 * cos, 200.0 * sin, 16.34], "start");
+    // The heading +y of blade A is turned too.
+    assert_near(
+        &scan.direction,
+        [200.0 * cos - 10.0 * sin, 200.0 * sin + 10.0 * cos, 16.34],
+        "direction point",
+    );
+    assert_near(&scan.start_normal, [0.0, 0.0, 1.0], "start normal");
+}
+
+/// Twelve nominals round a circle of radius 10 in the plane x = 200 about (200, 0, 20), counterclockwise
+/// from +y: the one at 90 degrees (index 3) points straight up.
+fn circle() -> Vec<NominalPoint> {
+    (0..12)
+        .map(|k| {
+            let (sin, cos) = (k as f64 * 30.0).to_radians().sin_cos();
+            NominalPoint {
+                point: [200.0, 10.0 * cos, 20.0 + 10.0 * sin],
+                normal: [0.0, cos, sin],
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
+    let plan = plan();
+    let nominals = circle();
+    let scan = plan.curve_scan(key(0, 1), &nominals);
+    assert!(scan.closed);
+    assert_eq!(scan.nominals.len(), 12);
+    assert_near(&scan.nominals[0].point, [200.0, 0.0, 30.0], "first point");
+    assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
+    // Then on round the circle the way it was taught, wrapping past the end of the list.
+    let (sin, cos) = 120f64.to_radians().sin_cos();
+    assert_near(
+        &scan.nominals[1].point,
+        [200.0, 10.0 * cos, 20.0 + 10.0 * sin],
+        "second",
+    );
+    assert_near(&scan.nominals[11].point, nominals[2].point, "last");
+    assert_eq!(scan.max_deviation, 3.0);
+    assert_eq!(scan.min_radius, 1.0);
+    assert_eq!(
+        scan.density,
+        Density::Spacing {
+            max_distance: 1.0,
+            max_angle: 10f64.to_radians()
+        }
+    );
+    let start = plan.scan_start(key(0, 1), Some(&nominals));
+    assert!(
+        (start - Point3::new(200.0, 0.0, 30.0)).norm() < 1e-9,
+        "{start}"
+    );
+}
+
+#[test]
+fn a_curve_scan_on_blade_b_turns_points_and_normals() {
+    let plan = plan();
+    let scan = plan.curve_scan(key(1, 1), &circle());
+    let (cos, sin) = TURN_120;
+    // The top (200, 0, 30) turned onto blade B; its normal, up, stays up.
+    assert_near(
+        &scan.nominals[0].point,
+        [200.0 * cos, 200.0 * sin, 30.0],
+        "first point",
+    );
+    assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
+    // The nominal at 0 degrees, (200, 10, 20) with normal +y, is ninth after the top.
+    let side = scan.nominals[9];
+    assert_near(
+        &side.point,
+        [200.0 * cos - 10.0 * sin, 200.0 * sin + 10.0 * cos, 20.0],
+        "side point",
+    );
+    assert_near(&side.normal, [-sin, cos, 0.0], "side normal");
+    let start = plan.scan_start(key(1, 1), Some(&circle()));
+    assert!((start - point(&scan.nominals[0].point)).norm() < 1e-12);
+}
+
+#[test]
+fn a_fixture_turn_that_tilts_nothing_keeps_the_upward_start() {
+    // Upward means +z in machine coordinates: a turn about z changes no normal's z.
+    let turned = Pose {
+        rot_z_deg: 37.0,
+        ..Pose::default()
+    };
+    let plan = Plan::new(&propeller_part(), turned.isometry());
+    let scan = plan.curve_scan(key(2, 0), &circle());
+    assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
+    let z: Vec<f64> = scan.nominals.iter().map(|n| n.point.z).collect();
+    assert_eq!(z.len(), 12);
+    assert!(
+        (z[0] - 30.0).abs() < 1e-9 && (z[6] - 10.0).abs() < 1e-9,
+        "{z:?}"
+    );
+}
+
+#[test]
+fn nearest_compares_horizontal_distances_and_breaks_ties_by_key() {
+    let plan = plan();
+    let starts = |k: ProfileKey| match (k.instance, k.profile) {
+        (0, 0) => Point3::new(100.0, 0.0, 0.0),
+        // Horizontally nearest to the origin, though 500 mm below it.
+        (0, 1) => Point3::new(30.0, 40.0, -500.0),
+        (1, 0) => Point3::new(0.0, 60.0, 0.0),
+        // As near as (0, 1): the tie goes to the smaller key.
+        (2, 3) => Point3::new(-50.0, 0.0, 0.0),
+        _ => unreachable!("not in the list"),
+    };
+    let from = Point3::new(0.0, 0.0, 0.0);
+    let remaining = [key(1, 0), key(2, 3), key(0, 0), key(0, 1)];
+    assert_eq!(plan.nearest(&remaining, from, starts), Some(3));
+    let reversed = [key(0, 1), key(0, 0), key(2, 3), key(1, 0)];
+    assert_eq!(plan.nearest(&reversed, from, starts), Some(0));
+    let without = [key(1, 0), key(2, 3), key(0, 0)];
+    assert_eq!(plan.nearest(&without, from, starts), Some(1));
+    assert_eq!(plan.nearest(&[], from, starts), None);
+}

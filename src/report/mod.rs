@@ -1,0 +1,146 @@
+//! The logged report of one inspected part: what was measured, on which machines, against which reference, by
+//! which distance and compensation, every point with its deviation, the statistics and the verdicts. One folder
+//! per part holds report.json (everything), deviations.csv (one row per point) and summary.txt (for the operator).
+
+mod summary;
+mod writers;
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
+use crate::geometry::fit3l::FitMethod;
+pub use summary::summary_text;
+pub use writers::{write_report, DEVIATIONS_FILE, REPORT_FILE, SUMMARY_FILE};
+
+pub const FORMAT: &str = "zeroset-report";
+pub const VERSION: u32 = 1;
+pub const UNITS: &str = "mm";
+
+/// The report of one inspected part.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct PartReport {
+    /// [`FORMAT`], [`VERSION`] and [`UNITS`].
+    pub format: String,
+    pub version: u32,
+    pub units: String,
+    pub part: String,
+    pub serial: String,
+    pub job: String,
+    /// RFC 3339.
+    pub started: String,
+    pub finished: String,
+    pub machines: Vec<MachineUse>,
+    pub reference: ReferenceUse,
+    /// How deviations were measured, e.g. "exact orthogonal distance to each profile's 2-D IP".
+    pub distance: String,
+    /// How ball centres became surface points, e.g. "ball radius along the reported normal".
+    pub compensation: String,
+    pub tolerance: Tolerance,
+    pub instances: Vec<InstanceReport>,
+    /// Pass iff every instance passes.
+    pub verdict: Verdict,
+}
+
+/// A machine that scanned some of the part's profiles.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct MachineUse {
+    pub name: String,
+    pub ball_radius_mm: f64,
+    pub profiles_scanned: usize,
+}
+
+/// The reference the deviations were measured against.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct ReferenceUse {
+    pub path: String,
+    pub taught_at: String,
+    pub method: FitMethod,
+    pub degree: usize,
+}
+
+/// One instance (blade) of the part: its statistics over all its profiles and their reports.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct InstanceReport {
+    pub name: String,
+    pub stats: DeviationStats,
+    pub verdict: Verdict,
+    pub profiles: Vec<ProfileReport>,
+}
+
+/// One scanned profile of an instance, with every point.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct ProfileReport {
+    pub name: String,
+    pub x_mm: f64,
+    pub machine: String,
+    /// RFC 3339.
+    pub scanned_at: String,
+    pub stats: DeviationStats,
+    pub verdict: Verdict,
+    pub points: Vec<PointRecord>,
+}
+
+/// One measured point: as reported, compensated, and its deviation.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct PointRecord {
+    /// Ball centre and outward unit normal as the machine reported them (machine frame, mm).
+    pub centre: [f64; 3],
+    pub normal: [f64; 3],
+    /// The compensated surface point (machine frame, mm).
+    pub surface: [f64; 3],
+    pub deviation_mm: f64,
+    pub off_plane_mm: f64,
+    /// The I++ quality the machine reported with the point.
+    pub quality: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReportError {
+    #[error("{path}: cannot read the report: {problem}")]
+    Read { path: String, problem: String },
+    #[error("{path}: not a readable report: {problem}")]
+    Parse { path: String, problem: String },
+    #[error("{path}: {problem}; read it with the zeroset version that wrote it")]
+    Unsupported { path: String, problem: String },
+}
+
+/// Reads the report.json of a part's report folder (for `zeroset report`).
+pub fn read_report(dir: &Path) -> Result<PartReport, ReportError> {
+    let path = dir.join(REPORT_FILE);
+    let shown = || path.display().to_string();
+    let text = std::fs::read_to_string(&path).map_err(|e| ReportError::Read {
+        path: shown(),
+        problem: e.to_string(),
+    })?;
+    let report: PartReport = serde_json::from_str(&text).map_err(|e| ReportError::Parse {
+        path: shown(),
+        problem: e.to_string(),
+    })?;
+    let unsupported = if report.format != FORMAT {
+        Some(format!("format '{}' is not '{FORMAT}'", report.format))
+    } else if report.version != VERSION {
+        Some(format!(
+            "version {} is not supported (this build reads version {VERSION})",
+            report.version
+        ))
+    } else if report.units != UNITS {
+        Some(format!(
+            "units '{}' (only {UNITS} are supported)",
+            report.units
+        ))
+    } else {
+        None
+    };
+    match unsupported {
+        Some(problem) => Err(ReportError::Unsupported {
+            path: shown(),
+            problem,
+        }),
+        None => Ok(report),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,180 @@
+//! The summary an operator reads at the machine: the part, what it was measured with and against, the tolerance,
+//! and one table row per instance (all its profiles) and per profile.
+
+use std::fmt::Write;
+
+use super::PartReport;
+use crate::analysis::stats::{DeviationStats, Verdict};
+
+/// Deviations are shown to 0.1 um, coordinates to 1 um.
+const DEVIATION_DECIMALS: usize = 4;
+const COORDINATE_DECIMALS: usize = 3;
+
+const COLUMNS: [&str; 11] = [
+    "instance",
+    "profile",
+    "x_mm",
+    "points",
+    "mean_mm",
+    "rms_mm",
+    "min_mm",
+    "max_mm",
+    "worst_mm",
+    "worst at (x, y, z) mm",
+    "verdict",
+];
+/// The first columns are names, left-aligned; the rest numbers, right-aligned; the verdict is left-aligned.
+const LEFT_ALIGNED: [usize; 3] = [0, 1, 10];
+
+/// The summary table as text (also printed by the CLI).
+pub fn summary_text(report: &PartReport) -> String {
+    let mut text = String::new();
+    let machines: Vec<String> = report
+        .machines
+        .iter()
+        .map(|m| {
+            format!(
+                "{} (ball radius {:.COORDINATE_DECIMALS$} mm, {} profiles)",
+                m.name, m.ball_radius_mm, m.profiles_scanned
+            )
+        })
+        .collect();
+    let reference = &report.reference;
+    let lines = [
+        (
+            "part",
+            format!(
+                "{}, serial {}, job {}",
+                report.part, report.serial, report.job
+            ),
+        ),
+        ("verdict", verdict_text(&report.verdict)),
+        ("started", report.started.clone()),
+        ("finished", report.finished.clone()),
+        (
+            "tolerance",
+            format!(
+                "{} mm to {} mm",
+                deviation(report.tolerance.lower_mm),
+                deviation(report.tolerance.upper_mm)
+            ),
+        ),
+        (
+            "reference",
+            format!(
+                "{} (taught {}; degree {}, {})",
+                reference.path,
+                reference.taught_at,
+                reference.degree,
+                reference.method.describe()
+            ),
+        ),
+        ("distance", report.distance.clone()),
+        ("compensation", report.compensation.clone()),
+        ("machines", machines.join("; ")),
+        (
+            "units",
+            "all lengths in mm, deviations positive outside the material".into(),
+        ),
+    ];
+    let label_width = lines
+        .iter()
+        .map(|(label, _)| label.len())
+        .max()
+        .unwrap_or(0);
+    for (label, value) in lines {
+        writeln!(text, "{label:<label_width$}  {value}").expect("writing to a String");
+    }
+    text.push('\n');
+    let mut rows = vec![COLUMNS.map(String::from).to_vec()];
+    for instance in &report.instances {
+        rows.push(row(
+            &instance.name,
+            "(all)",
+            None,
+            &instance.stats,
+            &instance.verdict,
+        ));
+        for profile in &instance.profiles {
+            rows.push(row(
+                &instance.name,
+                &profile.name,
+                Some(profile.x_mm),
+                &profile.stats,
+                &profile.verdict,
+            ));
+        }
+    }
+    text.push_str(&table(&rows));
+    text
+}
+
+fn row(
+    instance: &str,
+    profile: &str,
+    x_mm: Option<f64>,
+    stats: &DeviationStats,
+    verdict: &Verdict,
+) -> Vec<String> {
+    let at = stats
+        .worst_at_mm
+        .map(|c| format!("{c:.COORDINATE_DECIMALS$}"));
+    vec![
+        instance.to_string(),
+        profile.to_string(),
+        x_mm.map_or(String::new(), |x| format!("{x:.COORDINATE_DECIMALS$}")),
+        stats.points.to_string(),
+        deviation(stats.mean_mm),
+        format!("{:.DEVIATION_DECIMALS$}", stats.rms_mm),
+        deviation(stats.min_mm),
+        deviation(stats.max_mm),
+        deviation(stats.worst_mm),
+        format!("({})", at.join(", ")),
+        match verdict {
+            Verdict::Pass => "PASS".to_string(),
+            // The worst deviation has its own column.
+            Verdict::Fail { points_outside, .. } => format!("FAIL ({points_outside} outside)"),
+        },
+    ]
+}
+
+fn deviation(mm: f64) -> String {
+    format!("{mm:+.DEVIATION_DECIMALS$}")
+}
+
+fn verdict_text(verdict: &Verdict) -> String {
+    match verdict {
+        Verdict::Pass => "PASS".to_string(),
+        Verdict::Fail {
+            points_outside,
+            worst_mm,
+        } => format!(
+            "FAIL ({points_outside} points outside the tolerance, worst {} mm)",
+            deviation(*worst_mm)
+        ),
+    }
+}
+
+/// Rows padded to their columns' widths, two spaces apart.
+fn table(rows: &[Vec<String>]) -> String {
+    let widths: Vec<usize> = (0..COLUMNS.len())
+        .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
+        .collect();
+    let mut text = String::new();
+    for row in rows {
+        let cells: Vec<String> = row
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(c, (cell, &width))| {
+                if LEFT_ALIGNED.contains(&c) {
+                    format!("{cell:<width$}")
+                } else {
+                    format!("{cell:>width$}")
+                }
+            })
+            .collect();
+        writeln!(text, "{}", cells.join("  ").trim_end()).expect("writing to a String");
+    }
+    text
+}

@@ -1,0 +1,233 @@
+use super::*;
+use crate::analysis::stats::RunningStats;
+
+const TOLERANCE: Tolerance = Tolerance {
+    lower_mm: -0.1,
+    upper_mm: 0.1,
+};
+
+/// Deviations pushed beyond the tolerance, first to last.
+const EXCESSES: [f64; 2] = [0.11, 0.12];
+
+/// A profile of 7 points whose deviations are `base` plus a small ripple; the first `excess` of them outside.
+fn profile(
+    name: &str,
+    x_mm: f64,
+    base: f64,
+    excess: usize,
+) -> (ProfileReport, RunningStats, usize) {
+    let mut stats = RunningStats::default();
+    let mut outside = 0;
+    let points: Vec<PointRecord> = (0..7)
+        .map(|k| {
+            let t = k as f64 * 0.9;
+            let deviation_mm = if k < excess {
+                EXCESSES[k]
+            } else {
+                base + 0.001 * t.sin()
+            };
+            let surface = [x_mm, 40.0 * t.cos(), 8.0 * t.sin()];
+            stats.push(deviation_mm, surface);
+            outside += usize::from(!TOLERANCE.contains(deviation_mm));
+            PointRecord {
+                centre: [surface[0], surface[1] + 1.0, surface[2]],
+                normal: [0.0, 1.0, 0.0],
+                surface,
+                deviation_mm,
+                off_plane_mm: 0.002 * t,
+                quality: 1.0,
+            }
+        })
+        .collect();
+    let summary = stats.summary().unwrap();
+    let report = ProfileReport {
+        name: name.to_string(),
+        x_mm,
+        machine: "cmm-left".to_string(),
+        scanned_at: "2025-03-04T10:11:12Z".to_string(),
+        stats: summary,
+        verdict: TOLERANCE.verdict(&summary, outside),
+        points,
+    };
+    (report, stats, outside)
+}
+
+fn instance(name: &str, base: f64, excess: usize) -> InstanceReport {
+    let mut stats = RunningStats::default();
+    let mut profiles = Vec::new();
+    let mut outside = 0;
+    for (k, x) in [100.0, 300.0].into_iter().enumerate() {
+        let (report, profile_stats, profile_outside) =
+            profile(&format!("p{x}"), x, base, if k == 1 { excess } else { 0 });
+        stats.merge(&profile_stats);
+        outside += profile_outside;
+        profiles.push(report);
+    }
+    let summary = stats.summary().unwrap();
+    InstanceReport {
+        name: name.to_string(),
+        stats: summary,
+        verdict: TOLERANCE.verdict(&summary, outside),
+        profiles,
+    }
+}
+
+fn sample_report() -> PartReport {
+    let instances = vec![instance("blade-A", 0.004, 0), instance("blade-B", -0.02, 2)];
+    PartReport {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        units: UNITS.to_string(),
+        part: "propeller-3".to_string(),
+        serial: "SN-0042".to_string(),
+        job: "job-17".to_string(),
+        started: "2025-03-04T10:00:00Z".to_string(),
+        finished: "2025-03-04T10:20:00Z".to_string(),
+        machines: vec![MachineUse {
+            name: "cmm-left".to_string(),
+            ball_radius_mm: 1.0,
+            profiles_scanned: 4,
+        }],
+        reference: ReferenceUse {
+            path: "/var/lib/zeroset/references/propeller-3.json".to_string(),
+            taught_at: "2025-03-01T08:00:00Z".to_string(),
+            method: FitMethod::Orthogonal,
+            degree: 4,
+        },
+        distance: "exact orthogonal distance to each profile's 2-D IP".to_string(),
+        compensation: "ball radius along the reported normal".to_string(),
+        tolerance: TOLERANCE,
+        verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
+        instances,
+    }
+}
+
+fn file_names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn a_written_report_reads_back_as_it_was_and_leaves_only_its_three_files() {
+    let report = sample_report();
+    assert_eq!(
+        report.verdict,
+        Verdict::Fail {
+            points_outside: 2,
+            worst_mm: 0.12
+        }
+    );
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("propeller-3").join("SN-0042");
+    write_report(&dir, &report).unwrap();
+    assert_eq!(read_report(&dir).unwrap(), report);
+    assert_eq!(
+        file_names(&dir),
+        ["deviations.csv", "report.json", "summary.txt"]
+    );
+    // Writing again replaces the files, still without temporaries.
+    write_report(&dir, &report).unwrap();
+    assert_eq!(
+        file_names(&dir),
+        ["deviations.csv", "report.json", "summary.txt"]
+    );
+}
+
+#[test]
+fn deviations_csv_has_a_header_with_units_and_one_row_per_point() {
+    let report = sample_report();
+    let root = tempfile::tempdir().unwrap();
+    write_report(root.path(), &report).unwrap();
+    let text = std::fs::read_to_string(root.path().join(DEVIATIONS_FILE)).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[0],
+        "instance,profile,index,x_mm,y_mm,z_mm,deviation_mm,off_plane_mm,quality"
+    );
+    let points: usize = report
+        .instances
+        .iter()
+        .flat_map(|i| &i.profiles)
+        .map(|p| p.points.len())
+        .sum();
+    assert_eq!(points, 28);
+    assert_eq!(lines.len(), 1 + points);
+    // blade-B's second profile: its first point is outside, 0.11 mm, at (300, 40, 0).
+    let row = lines
+        .iter()
+        .find(|l| l.starts_with("blade-B,p300,0,"))
+        .expect("the row of blade-B p300 point 0");
+    assert_eq!(
+        *row,
+        "blade-B,p300,0,300.000000,40.000000,0.000000,0.110000,0.000000,1"
+    );
+}
+
+#[test]
+fn the_summary_names_instances_profiles_units_and_verdicts() {
+    let report = sample_report();
+    let text = summary_text(&report);
+    for expected in [
+        "propeller-3, serial SN-0042, job job-17",
+        "blade-A",
+        "blade-B",
+        "p300",
+        "mm",
+        "-0.1000 mm to +0.1000 mm",
+        "FAIL (2 points outside the tolerance, worst +0.1200 mm)",
+        "PASS",
+        "FAIL (2 outside)",
+        "cmm-left (ball radius 1.000 mm, 4 profiles)",
+        "degree 4",
+    ] {
+        assert!(text.contains(expected), "no '{expected}' in\n{text}");
+    }
+    // One header and one row per instance and per profile, aligned: every row's verdict starts in one column.
+    let table: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("instance"))
+        .collect();
+    assert_eq!(table.len(), 1 + 2 * 3, "{text}");
+    let verdict_column = table[0].find("verdict").unwrap();
+    for line in &table[1..] {
+        let verdict = &line[verdict_column..];
+        assert!(
+            verdict.starts_with("PASS") || verdict.starts_with("FAIL"),
+            "{line}"
+        );
+    }
+    let root = tempfile::tempdir().unwrap();
+    write_report(root.path(), &report).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(root.path().join(SUMMARY_FILE)).unwrap(),
+        text
+    );
+}
+
+#[test]
+fn reading_names_the_file_and_what_is_wrong() {
+    let root = tempfile::tempdir().unwrap();
+    let error = read_report(root.path()).unwrap_err();
+    assert!(
+        matches!(&error, ReportError::Read { path, .. } if path.ends_with("report.json")),
+        "{error}"
+    );
+    let mut report = sample_report();
+    report.version = 9;
+    write_report(root.path(), &report).unwrap();
+    let error = read_report(root.path()).unwrap_err().to_string();
+    assert!(
+        error.contains("report.json") && error.contains("version 9"),
+        "{error}"
+    );
+    let blocked = root.path().join("file-not-folder");
+    std::fs::write(&blocked, "x").unwrap();
+    let error = write_report(&blocked.join("inner"), &report)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("file-not-folder"), "{error}");
+}

@@ -1,0 +1,83 @@
+//! Writes a part's report folder. Each file is written to a temporary name and renamed, and report.json, the
+//! one that holds everything, comes last: a folder with a report.json is a complete report.
+
+use std::path::Path;
+
+use super::{summary_text, PartReport};
+use crate::fsutil::write_atomically;
+
+pub const REPORT_FILE: &str = "report.json";
+pub const DEVIATIONS_FILE: &str = "deviations.csv";
+pub const SUMMARY_FILE: &str = "summary.txt";
+
+/// Decimals of the millimetre values in deviations.csv: a nanometre, below any CMM's resolution (report.json
+/// holds every value exactly).
+const CSV_DECIMALS: usize = 6;
+
+/// The columns of deviations.csv; lengths are in mm, as their names say.
+const CSV_HEADER: [&str; 9] = [
+    "instance",
+    "profile",
+    "index",
+    "x_mm",
+    "y_mm",
+    "z_mm",
+    "deviation_mm",
+    "off_plane_mm",
+    "quality",
+];
+
+/// Writes report.json, deviations.csv (one row per point: instance, profile, index, x_mm, y_mm, z_mm of the surface
+/// point, deviation_mm, off_plane_mm, quality; header row names units) and summary.txt into `dir` (created if
+/// missing), each file atomically. Errors name the file.
+pub fn write_report(dir: &Path, report: &PartReport) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        std::io::Error::new(
+            e.kind(),
+            format!("cannot create the report folder {}: {e}", dir.display()),
+        )
+    })?;
+    write_atomically(&dir.join(DEVIATIONS_FILE), &deviations_csv(report))?;
+    write_atomically(&dir.join(SUMMARY_FILE), summary_text(report).as_bytes())?;
+    let json = serde_json::to_string_pretty(report).map_err(|e| {
+        std::io::Error::other(format!(
+            "cannot write {}: {e}",
+            dir.join(REPORT_FILE).display()
+        ))
+    })?;
+    write_atomically(&dir.join(REPORT_FILE), json.as_bytes())
+}
+
+fn deviations_csv(report: &PartReport) -> Vec<u8> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    let mm = |v: f64| format!("{v:.CSV_DECIMALS$}");
+    let rows = std::iter::once(CSV_HEADER.map(String::from).to_vec()).chain(
+        report.instances.iter().flat_map(|instance| {
+            instance.profiles.iter().flat_map(move |profile| {
+                profile
+                    .points
+                    .iter()
+                    .enumerate()
+                    .map(move |(index, point)| {
+                        vec![
+                            instance.name.clone(),
+                            profile.name.clone(),
+                            index.to_string(),
+                            mm(point.surface[0]),
+                            mm(point.surface[1]),
+                            mm(point.surface[2]),
+                            mm(point.deviation_mm),
+                            mm(point.off_plane_mm),
+                            point.quality.to_string(),
+                        ]
+                    })
+            })
+        }),
+    );
+    for row in rows {
+        writer
+            .write_record(&row)
+            .expect("writing to memory cannot fail");
+    }
+    writer.into_inner().expect("flushing to memory cannot fail")
+}
