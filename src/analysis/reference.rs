@@ -12,8 +12,10 @@ mod file;
 pub use self::file::ReferenceFileError;
 use super::nominals::thin_to_nominals;
 pub use super::nominals::NominalPoint;
-use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions};
+use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions, FitStats, Fitted};
 use crate::geometry::interp::StackError;
+use crate::geometry::normals::ordered_profile_normals;
+use crate::geometry::poly::MAX_DEGREE;
 use crate::model_file::{stack_of, FittedIp, ModelFile, ReferenceModel, StackProfile};
 
 pub const FORMAT: &str = "zeroset-reference";
@@ -142,6 +144,7 @@ pub fn teach(
             })
             .collect::<Result<_, _>>()
     })?;
+    let fitted = to_common_degree(fitted);
     stack_of(&fitted)?;
     let taught = profiles
         .iter()
@@ -167,6 +170,14 @@ pub fn teach(
 }
 
 /// The 2-D fit of one profile in its (y, z) plane, with warnings for the statistics an operator should see.
+///
+/// A single implicit polynomial follows a sharp trailing edge only as well as its 3L start lets the orthogonal
+/// refinement find, and which start does best varies from profile to profile. So four fits are made: at the
+/// configured degree and at two degrees more, each started from 3L offsets along the probe's normals and along normals
+/// taken from the points' order (at a sharp edge the probe reports a fan of normals for one touched point). The
+/// fit kept is the one with every point placed and the smallest RMS distance.
+/// Measured on the simulated NACA 4412 propeller (fit RMS, um, per profile r100..r500): degree 8 with the probe's
+/// normals 3.2, 38, 2.2, 2.0, 1.8; degree 10 with ordered normals 63, 2.4, 2.0, 1.9, 1.8.
 fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackProfile, TeachError> {
     let (name, x_mm) = (profile.name.clone(), profile.x_mm);
     if profile.normals.len() != profile.points.len() {
@@ -182,18 +193,42 @@ fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackPro
         .iter()
         .map(|p| Vector2::new(p.y, p.z))
         .collect();
-    let mut normals = Vec::with_capacity(profile.normals.len());
+    let mut probe_normals = Vec::with_capacity(profile.normals.len());
     for (index, n) in profile.normals.iter().enumerate() {
         match Vector2::new(n.y, n.z).try_normalize(0.0) {
-            Some(unit) if unit.iter().all(|c| c.is_finite()) => normals.push(unit),
+            Some(unit) if unit.iter().all(|c| c.is_finite()) => probe_normals.push(unit),
             _ => return Err(TeachError::NormalOutOfPlane { name, x_mm, index }),
         }
     }
-    let fitted = fit_ip(&points, &normals, options).map_err(|problem| TeachError::Fit {
-        name: name.clone(),
-        x_mm,
-        problem,
-    })?;
+    let ordered_normals = ordered_profile_normals(&points);
+    let degrees = [options.degree, options.degree + 2]
+        .into_iter()
+        .filter(|d| *d < MAX_DEGREE);
+    let mut best: Option<Fitted<2>> = None;
+    for degree in degrees {
+        for normals in [&probe_normals, &ordered_normals] {
+            let candidate = FitOptions { degree, ..*options };
+            let fitted = match fit_ip(&points, normals, &candidate) {
+                Ok(fitted) => fitted,
+                // The configured degree must fit; a higher one may not (too few points for it).
+                Err(_) if degree != options.degree => continue,
+                Err(problem) => {
+                    return Err(TeachError::Fit {
+                        name: name.clone(),
+                        x_mm,
+                        problem,
+                    })
+                }
+            };
+            if best
+                .as_ref()
+                .is_none_or(|b| better(&fitted.stats, &b.stats))
+            {
+                best = Some(fitted);
+            }
+        }
+    }
+    let fitted = best.expect("the configured degree was fitted or its error returned");
     let stats = &fitted.stats;
     if stats.zero_set_components > 1 || stats.side_segments_crossed_again > 0 {
         tracing::warn!(
@@ -213,6 +248,31 @@ fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackPro
             fit: Some(fitted.stats),
         },
     })
+}
+
+/// Whether `a` describes a closer fit than `b`: every point placed, then a smaller RMS. A sliver beside the data
+/// is not ruled out: on profile r200 of the simulated propeller the only fits without one miss the trailing edge by
+/// 0.38 mm, while the closest fit (2.4 um RMS) crosses one of 324 segments across the data twice; the sliver is
+/// counted in the model's statistics and warned about.
+fn better(a: &FitStats, b: &FitStats) -> bool {
+    (a.points_without_foot, a.rms_distance_mm) < (b.points_without_foot, b.rms_distance_mm)
+}
+
+/// The profiles written at one degree, the highest among them, so that they blend into one stack: a polynomial
+/// of a lower degree is the same polynomial with zero coefficients above it.
+fn to_common_degree(mut profiles: Vec<StackProfile>) -> Vec<StackProfile> {
+    let degree = profiles
+        .iter()
+        .map(|p| p.fitted.ip.poly.degree())
+        .max()
+        .unwrap_or(0);
+    for profile in &mut profiles {
+        let poly = &mut profile.fitted.ip.poly;
+        if poly.degree() < degree {
+            *poly = poly.elevated(degree);
+        }
+    }
+    profiles
 }
 
 #[cfg(test)]

@@ -1,11 +1,16 @@
 //! The `zeroset` command line: argument parsing and one module per command. Library errors are turned into one
 //! line an operator can act on: which file, which line, what is wrong.
 
+mod control;
+pub mod demo;
 mod deviate;
 mod fit;
+mod station;
+mod watch;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::api::Request;
 use crate::geometry::distance::DistanceMethod;
 use crate::geometry::fit3l::FitMethod;
 
@@ -22,6 +27,25 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Run the whole station on simulated machines: teach the propeller's blade A, inspect blades A, B, C live.
+    Demo(demo::DemoArgs),
+    /// Run the station daemon: it drives the machines and serves the operator commands below.
+    Daemon(station::StationFile),
+    /// Scan the master instance of a part and fit its reference model (shown live).
+    Teach(station::TeachArgs),
+    /// Scan every instance of a part and report its deviations (shown live); writes the part's report.
+    Inspect(station::InspectArgs),
+    /// Show the current job live: progress per instance and running deviation statistics (mm).
+    Watch(station::WatchArgs),
+    /// The machines and the current job.
+    Status(station::StatusArgs),
+    /// Stop all motion now and end the current job (its scans so far stay on disk).
+    Abort(station::StationFile),
+    /// Clear the machines' errors after the cause is removed, and continue a stopped job from its last complete
+    /// profile.
+    Clear(station::StationFile),
+    /// Print the newest report of a part serial number.
+    Report(station::ReportArgs),
     /// Fit a reference model to measured points.
     #[command(subcommand)]
     Fit(FitCommand),
@@ -89,6 +113,21 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
         Command::Deviate(args) => deviate::run(&args),
         Command::Sim(args) => zeroset_sim::cli::run(&args),
+        Command::Demo(args) => demo::run(&args),
+        Command::Daemon(station) => station::daemon(&station),
+        Command::Teach(args) => station::run_job(&args.job, Request::Teach { part: args.part }),
+        Command::Inspect(args) => station::run_job(
+            &args.job,
+            Request::Inspect {
+                part: args.part,
+                serial: args.serial,
+            },
+        ),
+        Command::Watch(args) => station::watch(&args),
+        Command::Status(args) => station::status(&args),
+        Command::Abort(station) => station::simple(&station, Request::Abort),
+        Command::Clear(station) => station::simple(&station, Request::Clear),
+        Command::Report(args) => station::report(&args),
     }
 }
 

@@ -144,6 +144,18 @@ impl<const N: usize> Poly<N> {
         self.basis.degree
     }
 
+    /// The same polynomial written over the basis of a higher degree (the new monomials' coefficients zero; the
+    /// basis is graded, so the old coefficients keep their places). Panics below the current degree.
+    pub fn elevated(&self, degree: usize) -> Self {
+        assert!(
+            degree >= self.degree(),
+            "cannot lower a polynomial's degree"
+        );
+        let mut coeffs = self.coeffs.clone();
+        coeffs.resize(Basis::<N>::len_for(degree), 0.0);
+        Self::new(degree, coeffs)
+    }
+
     pub fn basis(&self) -> &Basis<N> {
         &self.basis
     }
@@ -332,6 +344,21 @@ impl<'de, const N: usize> Deserialize<'de> for Poly<N> {
 mod tests {
     use super::*;
     use nalgebra::{Vector2, Vector3};
+
+    #[test]
+    fn an_elevated_polynomial_has_the_same_values() {
+        let coeffs: Vec<f64> = (0..Basis::<2>::len_for(4))
+            .map(|i| 0.5 - i as f64 * 0.1)
+            .collect();
+        let p = Poly::<2>::new(4, coeffs);
+        let q = p.elevated(6);
+        assert_eq!(q.degree(), 6);
+        for point in [Vector2::new(0.3, -0.7), Vector2::new(1.2, 0.4)] {
+            assert_eq!(p.value(&point), q.value(&point));
+        }
+        assert_eq!(q.coeff(&[2, 2]), p.coeff(&[2, 2]));
+        assert_eq!(q.coeff(&[6, 0]), 0.0);
+    }
 
     #[test]
     fn order_matches_seed_003() {

@@ -1,9 +1,11 @@
 //! End-to-end tests of the `zeroset` binary: one test binary, shared helpers, the real executables. The
 //! simulator runs as `zeroset sim` on pseudo-terminals and the station's I++ client talks to it through them.
 
+mod daemon;
 mod errors;
 mod fit_and_deviate;
 mod machine_link;
 mod readme;
 mod sim;
+mod station;
 mod support;

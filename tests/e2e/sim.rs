@@ -1,6 +1,7 @@
 //! A running simulator (`zeroset sim`, the real binary) and the station's I++ client on its pseudo-terminals.
 
 use std::io::{BufRead, BufReader, Write};
+use std::path::Path;
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 use std::time::Duration;
 
@@ -26,6 +27,15 @@ pub struct Sim {
 impl Sim {
     /// Starts `zeroset sim` with a configuration from config/sims/ and waits for its `machine NAME PATH` lines.
     pub fn start(name: &str) -> Sim {
+        Sim::launch(name, &[])
+    }
+
+    /// Like [`Sim::start`], with a link DIR/NAME to each machine's pseudo-terminal (what a station file names).
+    pub fn start_linked(name: &str, link_dir: &Path) -> Sim {
+        Sim::launch(name, &["--link-dir", &link_dir.display().to_string()])
+    }
+
+    fn launch(name: &str, extra: &[&str]) -> Sim {
         let path = config(&format!("sims/{name}"));
         let expected = SimConfig::load(path.as_ref())
             .expect("the config loads")
@@ -39,6 +49,7 @@ impl Sim {
                 "--time-scale",
                 &TIME_SCALE.to_string(),
             ])
+            .args(extra)
             .current_dir(repo())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
@@ -59,6 +70,11 @@ impl Sim {
             stdout,
             machines,
         }
+    }
+
+    /// The names of the simulated machines, in the configuration's order.
+    pub fn machines(&self) -> Vec<String> {
+        self.machines.iter().map(|(name, _)| name.clone()).collect()
     }
 
     pub fn path(&self, machine: &str) -> &str {

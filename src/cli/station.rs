@@ -1,0 +1,264 @@
+//! The operator's commands: run the daemon, teach, inspect, watch, status, abort, clear, report. Each talks to the
+//! daemon over the control socket named in the station file.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+
+use super::control::{accepted, Control};
+use super::watch::{JobEnd, Watch};
+use crate::api::{Reply, Request, StationStatus};
+use crate::config::StationConfig;
+
+/// The station file, shared by every station command.
+#[derive(Debug, Args, Clone)]
+pub struct StationFile {
+    /// The station's configuration (machines, probe, safety, folders, control socket).
+    #[arg(long, default_value = "config/station.toml")]
+    pub config: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct JobArgs {
+    #[command(flatten)]
+    pub station: StationFile,
+    /// Return once the job has started instead of following it to its end.
+    #[arg(long)]
+    pub detach: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct TeachArgs {
+    /// The part, as named by its file in the station's parts folder (e.g. propeller).
+    pub part: String,
+    #[command(flatten)]
+    pub job: JobArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The part, as named by its file in the station's parts folder (e.g. propeller).
+    pub part: String,
+    /// The part's serial number; it names the report's folder.
+    #[arg(long)]
+    pub serial: String,
+    #[command(flatten)]
+    pub job: JobArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct WatchArgs {
+    #[command(flatten)]
+    pub station: StationFile,
+    /// Write each event as the JSON line the daemon sent, instead of the display.
+    #[arg(long)]
+    pub events: bool,
+    /// Keep watching after the current job ends.
+    #[arg(long)]
+    pub follow: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct StatusArgs {
+    #[command(flatten)]
+    pub station: StationFile,
+    /// Write the status as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The part's serial number.
+    pub serial: String,
+    #[command(flatten)]
+    pub station: StationFile,
+}
+
+/// The control socket of a station file.
+pub fn socket_of(station: &StationFile) -> anyhow::Result<PathBuf> {
+    let config = StationConfig::load(&station.config)?;
+    Ok(config.control.socket)
+}
+
+fn connect(station: &StationFile) -> anyhow::Result<Control> {
+    Control::connect(&socket_of(station)?)
+}
+
+/// `zeroset daemon`: logs as JSON lines in the log folder (and a short form on stderr), then serves.
+pub fn daemon(station: &StationFile) -> anyhow::Result<()> {
+    let config = StationConfig::load(&station.config)?;
+    init_logging(&config.folders.logs)?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
+    runtime.block_on(crate::station::run(config))
+}
+
+fn init_logging(folder: &Path) -> anyhow::Result<()> {
+    use tracing_subscriber::layer::SubscriberExt;
+    use tracing_subscriber::util::SubscriberInitExt;
+    use tracing_subscriber::{fmt, EnvFilter, Layer};
+    std::fs::create_dir_all(folder)
+        .with_context(|| format!("cannot create {}", folder.display()))?;
+    let path = folder.join("zeroset-daemon.jsonl");
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .with_context(|| format!("cannot open the log {}", path.display()))?;
+    let filter =
+        || EnvFilter::try_from_env("ZEROSET_LOG").unwrap_or_else(|_| EnvFilter::new("info"));
+    tracing_subscriber::registry()
+        .with(
+            fmt::layer()
+                .json()
+                .with_writer(std::sync::Mutex::new(file))
+                .with_filter(filter()),
+        )
+        .with(
+            fmt::layer()
+                .compact()
+                .with_writer(std::io::stderr)
+                .with_filter(filter()),
+        )
+        .try_init()
+        .context("starting the log")?;
+    Ok(())
+}
+
+/// `zeroset teach` and `zeroset inspect`: starts the job and, unless detached, shows it live to its end.
+pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<()> {
+    // Subscribed before the job starts, so that none of its events are missed.
+    let events = if job.detach {
+        None
+    } else {
+        Some(connect(&job.station)?.subscribe()?)
+    };
+    let reply = accepted(connect(&job.station)?.request(request)?)?;
+    let Reply::Started { job: info } = reply else {
+        anyhow::bail!("unexpected reply from the daemon: {reply:?}");
+    };
+    let Some(events) = events else {
+        println!("job {} started; follow it with `zeroset watch`", info.id);
+        return Ok(());
+    };
+    let end = follow(events, Some(info.id), false, false)?;
+    ended(end)
+}
+
+/// `zeroset watch`.
+pub fn watch(args: &WatchArgs) -> anyhow::Result<()> {
+    let mut control = connect(&args.station)?;
+    let status = match accepted(control.request(Request::Status)?)? {
+        Reply::Status(status) => status,
+        other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
+    };
+    let events = control.subscribe()?;
+    if !args.events {
+        print_status(&status);
+    }
+    let job = status
+        .job
+        .filter(|j| {
+            !["finished", "aborted"].contains(&j.state.as_str()) && !j.state.starts_with("failed")
+        })
+        .map(|j| j.job.id);
+    follow(events, job, args.events, args.follow).map(drop)
+}
+
+fn follow(
+    mut events: super::control::Events,
+    job: Option<String>,
+    raw: bool,
+    forever: bool,
+) -> anyhow::Result<JobEnd> {
+    let mut watch = Watch::new(job, raw);
+    loop {
+        let (event, line) = events.next()?;
+        if raw {
+            print!("{line}");
+        }
+        if let Some(end) = watch.show(&event) {
+            if !forever {
+                return Ok(end);
+            }
+        }
+    }
+}
+
+fn ended(end: JobEnd) -> anyhow::Result<()> {
+    match end {
+        JobEnd::Finished { .. } => Ok(()),
+        JobEnd::Aborted => anyhow::bail!("the job was aborted"),
+        JobEnd::Failed(error) => anyhow::bail!("the job failed: {error}"),
+    }
+}
+
+pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
+    match accepted(connect(&args.station)?.request(Request::Status)?)? {
+        Reply::Status(status) if args.json => {
+            println!("{}", serde_json::to_string_pretty(&status)?);
+            Ok(())
+        }
+        Reply::Status(status) => {
+            print_status(&status);
+            Ok(())
+        }
+        other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
+    }
+}
+
+fn print_status(status: &StationStatus) {
+    println!("station {}", status.station);
+    for machine in &status.machines {
+        println!("  machine {}: {}", machine.name, machine.state);
+    }
+    match &status.job {
+        Some(job) => {
+            println!(
+                "  job {} ({} {}): {}, {}/{} profiles done",
+                job.job.id,
+                match job.job.kind {
+                    crate::api::JobKind::Teach => "teach",
+                    crate::api::JobKind::Inspect => "inspect",
+                },
+                job.job.part,
+                job.state,
+                job.profiles_done,
+                job.profiles_total
+            );
+            if let Some(stopped) = &job.stopped {
+                println!("  stopped: {stopped}");
+            }
+        }
+        None => println!("  no job"),
+    }
+}
+
+/// `zeroset abort` and `zeroset clear`: one request, its answer printed.
+pub fn simple(station: &StationFile, request: Request) -> anyhow::Result<()> {
+    match accepted(connect(station)?.request(request)?)? {
+        Reply::Done { message } => {
+            println!("{message}");
+            Ok(())
+        }
+        other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
+    }
+}
+
+pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
+    let request = Request::Report {
+        serial: args.serial.clone(),
+    };
+    match accepted(connect(&args.station)?.request(request)?)? {
+        Reply::Report { dir, summary } => {
+            println!("{summary}");
+            println!("report folder: {}", dir.display());
+            Ok(())
+        }
+        other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
+    }
+}

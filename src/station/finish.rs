@@ -1,0 +1,251 @@
+//! The end of a job, from its scan files on disk (the one record of what was measured, whether the job ran in
+//! one go or was resumed): a teach fits and saves the reference; an inspection measures every point against the
+//! reference again and writes the part's report. Both are CPU work and run off the daemon's tasks.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+
+use super::job::job_scans;
+use super::journal::{file_stem, JobDir, JobRecord};
+use super::pipeline::{in_part_frame, scan_ref};
+use crate::analysis::deviation::ProfileGauge;
+use crate::analysis::reference::{teach, MasterProfile, Reference, ReferenceSettings};
+use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
+use crate::analysis::surface_point;
+use crate::api::{InstanceSummary, JobKind, ProfileFit};
+use crate::plan::Plan;
+use crate::report::{
+    write_report, InstanceReport, MachineUse, PartReport, PointRecord, ProfileReport, ReferenceUse,
+};
+
+/// How a finished job ended.
+#[derive(Debug)]
+pub enum Outcome {
+    Taught {
+        path: PathBuf,
+        profiles: Vec<ProfileFit>,
+    },
+    Inspected {
+        dir: PathBuf,
+        instances: Vec<InstanceSummary>,
+        verdict: Verdict,
+    },
+}
+
+/// Fits the reference from the master's scans and saves it at `path`.
+pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, String> {
+    let mut profiles = Vec::new();
+    for key in job_scans(plan, JobKind::Teach) {
+        let scan = dir
+            .read_scan(&scan_ref(plan, key))
+            .map_err(|e| e.to_string())?;
+        let to_part = plan.instance_to_machine(key.instance).inverse();
+        let (points, normals) = scan
+            .points
+            .iter()
+            .map(|raw| {
+                (
+                    in_part_frame(plan, key, raw, scan.header.ball_radius_mm),
+                    to_part * Vector3::from(raw.normal).normalize(),
+                )
+            })
+            .unzip();
+        profiles.push(MasterProfile {
+            name: plan.profile_names()[key.profile].to_string(),
+            x_mm: plan.profile_x(key.profile),
+            points,
+            normals,
+        });
+    }
+    let entry = plan.reference_settings();
+    let settings = ReferenceSettings {
+        degree: entry.degree,
+        method: entry.method,
+        nominal_spacing_mm: entry.nominal_spacing_mm,
+    };
+    let reference = teach(plan.part(), &profiles, &settings).map_err(|e| e.to_string())?;
+    if let Some(folder) = path.parent() {
+        std::fs::create_dir_all(folder)
+            .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
+    }
+    reference.save(path).map_err(|e| e.to_string())?;
+    let fits = reference_fits(&reference, &profiles);
+    Ok(Outcome::Taught {
+        path: path.to_path_buf(),
+        profiles: fits,
+    })
+}
+
+fn reference_fits(reference: &Reference, profiles: &[MasterProfile]) -> Vec<ProfileFit> {
+    let crate::model_file::ReferenceModel::Stack { profiles: fitted } = &reference.model.model
+    else {
+        return Vec::new();
+    };
+    fitted
+        .iter()
+        .zip(profiles)
+        .map(|(stack, master)| {
+            let stats = stack.fitted.fit.as_ref();
+            ProfileFit {
+                profile: master.name.clone(),
+                points: master.points.len(),
+                rms_mm: stats.map_or(f64::NAN, |s| s.rms_distance_mm),
+                max_mm: stats.map_or(f64::NAN, |s| s.max_distance_mm),
+            }
+        })
+        .collect()
+}
+
+/// What an inspection's report needs besides its scans.
+pub struct ReportInputs<'a> {
+    pub plan: &'a Plan,
+    pub dir: &'a JobDir,
+    pub record: &'a JobRecord,
+    pub reference: &'a Reference,
+    pub reference_path: &'a Path,
+    pub gauges: &'a [ProfileGauge],
+    pub tolerance: Tolerance,
+    pub reports: &'a Path,
+}
+
+/// Measures every scanned point against the reference and writes the part's report folder.
+pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
+    let ReportInputs { plan, dir, .. } = inputs;
+    let serial = inputs.record.serial.clone().unwrap_or_default();
+    let mut machines: BTreeMap<String, MachineUse> = BTreeMap::new();
+    let mut instances: Vec<InstanceReport> = Vec::new();
+    for (instance, name) in plan.instance_names().iter().enumerate() {
+        let mut profiles = Vec::new();
+        let mut all = RunningStats::default();
+        let mut outside = 0;
+        for key in job_scans(plan, JobKind::Inspect)
+            .into_iter()
+            .filter(|k| k.instance == instance)
+        {
+            let scan_name = scan_ref(plan, key);
+            let scan = dir.read_scan(&scan_name).map_err(|e| e.to_string())?;
+            let radius = scan.header.ball_radius_mm;
+            machines
+                .entry(scan.header.machine.clone())
+                .or_insert_with(|| MachineUse {
+                    name: scan.header.machine.clone(),
+                    ball_radius_mm: radius,
+                    profiles_scanned: 0,
+                })
+                .profiles_scanned += 1;
+            let mut gauge = inputs.gauges[key.profile].scan();
+            let mut stats = RunningStats::default();
+            let mut profile_outside = 0;
+            let mut points = Vec::with_capacity(scan.points.len());
+            for raw in &scan.points {
+                let surface = surface_point(raw, radius);
+                let measured = gauge
+                    .measure(&in_part_frame(plan, key, raw, radius))
+                    .map_err(|e| {
+                        format!(
+                            "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
+                            plan.describe(key),
+                            file_stem(&scan_name),
+                            surface.x,
+                            surface.y,
+                            surface.z
+                        )
+                    })?;
+                stats.push(measured.deviation_mm, surface.coords.into());
+                if !inputs.tolerance.contains(measured.deviation_mm) {
+                    profile_outside += 1;
+                }
+                points.push(PointRecord {
+                    centre: raw.centre,
+                    normal: raw.normal,
+                    surface: surface.coords.into(),
+                    deviation_mm: measured.deviation_mm,
+                    off_plane_mm: measured.off_plane_mm,
+                    quality: raw.quality,
+                });
+            }
+            let summary = stats
+                .summary()
+                .ok_or_else(|| format!("{}: the scan has no points", plan.describe(key)))?;
+            all.merge(&stats);
+            outside += profile_outside;
+            profiles.push(ProfileReport {
+                name: scan_name.profile.clone(),
+                x_mm: plan.profile_x(key.profile),
+                machine: scan.header.machine.clone(),
+                scanned_at: scan.finished.clone(),
+                stats: summary,
+                verdict: inputs.tolerance.verdict(&summary, profile_outside),
+                points,
+            });
+        }
+        let stats = all
+            .summary()
+            .ok_or_else(|| format!("instance {name} has no points"))?;
+        instances.push(InstanceReport {
+            name: name.clone(),
+            verdict: inputs.tolerance.verdict(&stats, outside),
+            stats,
+            profiles,
+        });
+    }
+    let verdict = Verdict::combine(instances.iter().map(|i| &i.verdict));
+    let settings = &inputs.reference.settings;
+    let report = PartReport {
+        format: crate::report::FORMAT.to_string(),
+        version: crate::report::VERSION,
+        units: "mm".to_string(),
+        part: plan.part().to_string(),
+        serial: serial.clone(),
+        job: inputs.record.id.clone(),
+        started: inputs.record.started.clone(),
+        finished: super::clock::now_rfc3339(),
+        machines: machines.into_values().collect(),
+        reference: ReferenceUse {
+            path: inputs.reference_path.display().to_string(),
+            taught_at: inputs.reference.taught_at.clone(),
+            method: settings.method,
+            degree: settings.degree,
+        },
+        distance: "exact orthogonal distance to each profile's 2-D implicit polynomial, in the master's frame".into(),
+        compensation: "ball centre moved back one ball radius along the reported surface normal".into(),
+        tolerance: inputs.tolerance,
+        instances,
+        verdict: verdict.clone(),
+    };
+    let folder = inputs
+        .reports
+        .join(plan.part())
+        .join(&serial)
+        .join(&inputs.record.id);
+    write_report(&folder, &report).map_err(|e| e.to_string())?;
+    copy_scans(dir, &folder).map_err(|e| e.to_string())?;
+    let summaries = report
+        .instances
+        .iter()
+        .map(|i| InstanceSummary {
+            instance: i.name.clone(),
+            stats: Some(i.stats),
+            verdict: Some(i.verdict.clone()),
+        })
+        .collect();
+    Ok(Outcome::Inspected {
+        dir: folder,
+        instances: summaries,
+        verdict,
+    })
+}
+
+/// The raw scans go with the report, so that it can be analysed again without the daemon's data folder.
+fn copy_scans(dir: &JobDir, folder: &Path) -> std::io::Result<()> {
+    let target = folder.join("scans");
+    std::fs::create_dir_all(&target)?;
+    for name in dir.completed()? {
+        let file = format!("{name}.json");
+        let bytes = std::fs::read(dir.path().join("scans").join(&file))?;
+        crate::fsutil::write_atomically(&target.join(file), &bytes)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,105 @@
+//! The daemon: one task per machine owns its line (`worker`), one task per job analyses its points (`pipeline`),
+//! one task serves the control socket (`control`), and one task owns the station's state and makes every decision
+//! (`daemon`): which machine scans what next, when a job stops, resumes, or ends. They talk only through channels.
+
+pub mod clock;
+mod control;
+mod daemon;
+mod escape;
+mod finish;
+mod job;
+mod journal;
+mod pipeline;
+mod worker;
+
+use tokio::sync::{broadcast, mpsc, oneshot};
+
+use crate::api::{Reply, Request};
+use crate::config::StationConfig;
+use crate::plan::ProfileKey;
+use worker::ScanResult;
+
+pub use escape::{way_out, EscapeError, KnownPath};
+
+/// How many events a watcher may fall behind before it misses some: a whole inspection's points.
+const EVENT_BACKLOG: usize = 1 << 16;
+
+/// What the daemon's state task hears.
+pub enum DaemonMsg {
+    /// A request from the control socket.
+    Request {
+        request: Request,
+        reply: oneshot::Sender<Reply>,
+    },
+    /// A worker ended a scan order.
+    ScanEnded {
+        machine: String,
+        key: ProfileKey,
+        result: ScanResult,
+    },
+    /// The pipeline stored a profile's scan on disk (or could not).
+    Stored {
+        job: String,
+        key: ProfileKey,
+        result: Result<(), String>,
+    },
+    /// A worker cleared its machine (or could not).
+    Cleared {
+        machine: String,
+        result: Result<(), String>,
+    },
+    /// A job's reference was fitted or its report written.
+    Finished {
+        job: String,
+        result: Result<finish::Outcome, String>,
+    },
+}
+
+/// Runs the daemon until SIGINT or SIGTERM: binds the control socket, starts a worker per machine, reopens a job
+/// a previous daemon left open, and serves.
+pub async fn run(config: StationConfig) -> anyhow::Result<()> {
+    for folder in [
+        &config.folders.data,
+        &config.folders.reports,
+        &config.folders.logs,
+    ] {
+        std::fs::create_dir_all(folder)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", folder.display()))?;
+    }
+    let listener = control::bind(&config.control.socket)?;
+    let (to_daemon, inbox) = mpsc::channel(1024);
+    let (events, _) = broadcast::channel(EVENT_BACKLOG);
+    let workers = config
+        .machines
+        .iter()
+        .map(|m| {
+            worker::spawn(
+                m.clone(),
+                config.probe.clone(),
+                config.safety.clone(),
+                to_daemon.clone(),
+            )
+        })
+        .collect();
+    tokio::spawn(control::serve(listener, to_daemon.clone(), events.clone()));
+    let socket = config.control.socket.clone();
+    let state = daemon::Daemon::start(config, workers, events, to_daemon)?;
+    tracing::info!(socket = %socket.display(), "daemon ready");
+    let result = tokio::select! {
+        () = state.run(inbox) => Ok(()),
+        signal = shutdown_signal() => signal,
+    };
+    let _ = std::fs::remove_file(&socket);
+    result
+}
+
+async fn shutdown_signal() -> anyhow::Result<()> {
+    use tokio::signal::unix::{signal, SignalKind};
+    let mut terminate = signal(SignalKind::terminate())?;
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {}
+        _ = terminate.recv() => {}
+    }
+    tracing::info!("stopping on a signal; an open job resumes after `zeroset clear`");
+    Ok(())
+}

@@ -1,0 +1,221 @@
+//! A whole station for a test: the simulator (`zeroset sim`) with its machines linked into a temporary folder, a
+//! station file pointing at them, and the real daemon (`zeroset daemon`) on its own socket; the CLI commands run
+//! as the real binary against it.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdout, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use zeroset::api::{parse_line, Event, EventLine};
+use zeroset::report::PartReport;
+
+use crate::sim::Sim;
+use crate::support::{config, repo, zeroset, Run};
+
+pub struct Station {
+    pub sim: Sim,
+    pub root: tempfile::TempDir,
+    pub station_file: PathBuf,
+    daemon: Option<Child>,
+    daemons_started: usize,
+}
+
+impl Station {
+    /// The simulator of config/sims/`sim_config` and a daemon driving all its machines.
+    pub fn start(sim_config: &str) -> Station {
+        let root = tempfile::tempdir().expect("a temporary folder");
+        let ports = root.path().join("ports");
+        let sim = Sim::start_linked(sim_config, &ports);
+        let text = zeroset::cli::demo::station_for_simulator(
+            Path::new(&config("station.toml")),
+            &sim.machines(),
+            &ports,
+            root.path(),
+        )
+        .expect("a station file");
+        let station_file = root.path().join("station.toml");
+        std::fs::write(&station_file, text).expect("the station file is written");
+        let mut station = Station {
+            sim,
+            root,
+            station_file,
+            daemon: None,
+            daemons_started: 0,
+        };
+        station.start_daemon();
+        station
+    }
+
+    pub fn start_daemon(&mut self) {
+        self.daemons_started += 1;
+        let log = std::fs::File::create(
+            self.root
+                .path()
+                .join(format!("daemon-{}.stderr", self.daemons_started)),
+        )
+        .expect("a log file");
+        let child = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+            .args(["daemon", "--config"])
+            .arg(&self.station_file)
+            .current_dir(repo())
+            .stderr(log)
+            .spawn()
+            .expect("the daemon starts");
+        self.daemon = Some(child);
+        let socket = self.socket();
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while std::os::unix::net::UnixStream::connect(&socket).is_err() {
+            assert!(
+                Instant::now() < deadline,
+                "the daemon did not open {socket:?}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// `kill -9`: no chance to tidy up.
+    pub fn kill_daemon(&mut self) {
+        let mut child = self.daemon.take().expect("a running daemon");
+        child.kill().expect("SIGKILL");
+        child.wait().expect("reaped");
+    }
+
+    pub fn socket(&self) -> PathBuf {
+        self.root.path().join("zeroset.sock")
+    }
+
+    pub fn reports(&self) -> PathBuf {
+        self.root.path().join("reports")
+    }
+
+    pub fn data(&self) -> PathBuf {
+        self.root.path().join("data")
+    }
+
+    /// Runs `zeroset COMMAND ARGS --config STATION`.
+    pub fn cli(&self, args: &[&str]) -> Run {
+        let mut all: Vec<&str> = args.to_vec();
+        let file = self.station_file.display().to_string();
+        all.extend(["--config", &file]);
+        zeroset(&all)
+    }
+
+    pub fn cli_ok(&self, args: &[&str]) -> String {
+        let run = self.cli(args);
+        assert!(
+            run.success,
+            "zeroset {args:?} failed:\n{}\n{}",
+            run.stdout, run.stderr
+        );
+        run.stdout
+    }
+
+    /// `zeroset watch --events --follow` in the background; its events arrive on the receiver.
+    pub fn watch(&self) -> Watcher {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+            .args(["watch", "--events", "--follow", "--config"])
+            .arg(&self.station_file)
+            .current_dir(repo())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("zeroset watch starts");
+        let stdout = child.stdout.take().expect("piped");
+        let (lines, receiver) = mpsc::channel();
+        std::thread::spawn(move || forward(stdout, lines));
+        let watcher = Watcher {
+            child,
+            events: receiver,
+            seen: Vec::new(),
+        };
+        // `watch` prints nothing before it subscribes; give it a moment so no early event is missed.
+        std::thread::sleep(Duration::from_millis(300));
+        watcher
+    }
+
+    /// The report of the newest inspection of `serial`.
+    pub fn report(&self, serial: &str) -> (PathBuf, PartReport) {
+        let dir = std::fs::read_dir(self.reports().join("propeller").join(serial))
+            .expect("a report folder for the serial")
+            .map(|e| e.unwrap().path())
+            .max()
+            .expect("one report");
+        let report = zeroset::report::read_report(&dir).expect("the report reads");
+        (dir, report)
+    }
+}
+
+impl Drop for Station {
+    fn drop(&mut self) {
+        if let Some(mut child) = self.daemon.take() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+fn forward(stdout: ChildStdout, lines: mpsc::Sender<String>) {
+    for line in BufReader::new(stdout).lines() {
+        let Ok(line) = line else { return };
+        if lines.send(line).is_err() {
+            return;
+        }
+    }
+}
+
+/// A running `zeroset watch --events`.
+pub struct Watcher {
+    child: Child,
+    events: mpsc::Receiver<String>,
+    /// Every line received so far.
+    pub seen: Vec<String>,
+}
+
+impl Watcher {
+    /// Waits for the first event that `wanted` accepts (seconds at most), keeping every line seen.
+    pub fn until(&mut self, seconds: u64, mut wanted: impl FnMut(&Event) -> bool) -> Event {
+        let deadline = Instant::now() + Duration::from_secs(seconds);
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let line = self.events.recv_timeout(left).unwrap_or_else(|_| {
+                panic!("no such event within {seconds} s; saw:\n{}", self.tail())
+            });
+            self.seen.push(line.clone());
+            let event = parse_line::<EventLine>(&line).expect("an event line").event;
+            if wanted(&event) {
+                return event;
+            }
+        }
+    }
+
+    pub fn events(&self) -> Vec<Event> {
+        self.seen
+            .iter()
+            .map(|l| parse_line::<EventLine>(l).expect("an event line").event)
+            .collect()
+    }
+
+    fn tail(&self) -> String {
+        let start = self.seen.len().saturating_sub(10);
+        self.seen[start..].join("\n")
+    }
+}
+
+impl Drop for Watcher {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Whether an event ends a job.
+pub fn job_over(event: &Event) -> bool {
+    matches!(
+        event,
+        Event::ReferenceSaved { .. }
+            | Event::JobFinished { .. }
+            | Event::JobAborted { .. }
+            | Event::JobFailed { .. }
+    )
+}
