@@ -1,0 +1,406 @@
+//! The station end to end: the real daemon, simulator and CLI over pseudo-terminals. Teach and inspect of the
+//! simulated propeller checked against the simulator's own analytic blades; two machines scanning at once; an
+//! emergency stop and a killed daemon, each resumed with no point lost or counted twice; two watchers.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use nalgebra::{Point2, Point3, Rotation3, Vector3};
+use zeroset::api::Event;
+use zeroset::report::PartReport;
+use zeroset_sim::part::curve::SampledCurve;
+
+use crate::daemon::{job_over, Station};
+use crate::sim::propeller;
+
+/// The agreement the issue asks for between measured and injected errors, mm.
+const AGREEMENT_MM: f64 = 0.005;
+
+/// Per profile of each instance: the deviation the simulator's ground truth gives for each of the very points the
+/// report holds (their distance to blade A's analytic section, the master's true shape).
+fn ground_truth(report: &PartReport) -> BTreeMap<(String, String), Vec<f64>> {
+    let truth = propeller();
+    let mut expected = BTreeMap::new();
+    for (k, instance) in report.instances.iter().enumerate() {
+        let turn =
+            Rotation3::from_axis_angle(&Vector3::z_axis(), -(k as f64) * 120f64.to_radians());
+        for profile in &instance.profiles {
+            let frame = truth.section_frame(0, profile.x_mm);
+            let section = SampledCurve::new(truth.section_curve(0, profile.x_mm));
+            let distances: Vec<f64> = profile
+                .points
+                .iter()
+                .map(|p| {
+                    let master = turn * Point3::from(p.surface);
+                    let local = frame.local(&master);
+                    section
+                        .nearest(&Point2::new(local.x, local.y))
+                        .signed_distance
+                })
+                .collect();
+            expected.insert((instance.name.clone(), profile.name.clone()), distances);
+        }
+    }
+    expected
+}
+
+fn mean_and_rms(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let rms = (values.iter().map(|d| d * d).sum::<f64>() / n).sqrt();
+    (mean, rms)
+}
+
+/// The points where the report and the ground truth disagree most, for a failure message.
+fn worst_disagreements(profile: &zeroset::report::ProfileReport, truth: &[f64]) -> String {
+    let mut points: Vec<(f64, usize)> = profile
+        .points
+        .iter()
+        .zip(truth)
+        .enumerate()
+        .map(|(i, (p, t))| ((p.deviation_mm - t).abs(), i))
+        .collect();
+    points.sort_by(|a, b| b.0.total_cmp(&a.0));
+    points
+        .iter()
+        .take(5)
+        .map(|(_, i)| {
+            let p = &profile.points[*i];
+            format!(
+                "  point {i} at {:?}: {:+.4} mm, truth {:+.4} mm",
+                p.surface, p.deviation_mm, truth[*i]
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Teaches the propeller, failing the test with what the CLI printed if it does not work.
+fn teach(station: &Station) {
+    let out = station.cli_ok(&["teach", "propeller"]);
+    assert!(out.contains("reference saved"), "{out}");
+}
+
+/// Points per profile of an inspection report.
+fn point_counts(report: &PartReport) -> BTreeMap<(String, String), usize> {
+    report
+        .instances
+        .iter()
+        .flat_map(|i| {
+            i.profiles
+                .iter()
+                .map(|p| ((i.name.clone(), p.name.clone()), p.points.len()))
+        })
+        .collect()
+}
+
+/// No point of a profile appears twice (a resumed scan appended to a cut one would repeat the start).
+fn assert_no_repeated_points(report: &PartReport) {
+    for instance in &report.instances {
+        for profile in &instance.profiles {
+            for (i, a) in profile.points.iter().enumerate() {
+                for b in &profile.points[i + 1..] {
+                    let gap = (Point3::from(a.centre) - Point3::from(b.centre)).norm();
+                    assert!(
+                        gap > 1e-3,
+                        "instance {} profile {}: a point appears twice at {:?}",
+                        instance.name,
+                        profile.name,
+                        a.centre
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn teach_and_inspect_measure_the_simulated_blade_errors() {
+    let station = Station::start("propeller.toml");
+    teach(&station);
+    let out = station.cli_ok(&["inspect", "propeller", "--serial", "SN-1"]);
+    assert!(out.contains("report: "), "{out}");
+    for blade in ["A", "B", "C"] {
+        assert!(
+            out.lines().any(|l| l.starts_with(blade)),
+            "a row per blade:\n{out}"
+        );
+    }
+    let (dir, report) = station.report("SN-1");
+    for file in ["report.json", "deviations.csv", "summary.txt"] {
+        assert!(dir.join(file).is_file(), "{file} in {dir:?}");
+    }
+    let truth = ground_truth(&report);
+    let mut problems = Vec::new();
+    for instance in &report.instances {
+        for profile in &instance.profiles {
+            let expected = &truth[&(instance.name.clone(), profile.name.clone())];
+            let (mean, rms) = mean_and_rms(expected);
+            let what = format!("blade {} profile {}", instance.name, profile.name);
+            assert!(
+                profile.points.len() > 100,
+                "{what}: {} points",
+                profile.points.len()
+            );
+            let stats = &profile.stats;
+            if (stats.mean_mm - mean).abs() >= AGREEMENT_MM
+                || (stats.rms_mm - rms).abs() >= AGREEMENT_MM
+            {
+                problems.push(format!(
+                    "{what}: mean {:+.5} mm and RMS {:.5} mm; the simulator's blade gives {mean:+.5} mm and {rms:.5} mm\n{}",
+                    stats.mean_mm,
+                    stats.rms_mm,
+                    worst_disagreements(profile, expected)
+                ));
+            }
+            if instance.name == "A" {
+                assert!(stats.mean_mm.abs() < AGREEMENT_MM, "{what}: {stats:?}");
+            } else {
+                // Blades B and C are shifted 0.4 to 1.0 mm along the hub axis: far outside the noise.
+                assert!(stats.rms_mm > 0.1, "{what}: {stats:?}");
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(report.instances[0].verdict.passed(), "blade A passes");
+    assert!(!report.instances[1].verdict.passed(), "blade B fails");
+    let summary = station.cli_ok(&["report", "SN-1"]);
+    assert!(
+        summary.contains("mm") && summary.contains(&dir.display().to_string()),
+        "{summary}"
+    );
+}
+
+#[test]
+fn two_machines_scan_profiles_at_the_same_time() {
+    let station = Station::start("two-machines.toml");
+    let mut watcher = station.watch();
+    teach(&station);
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-2"]);
+    watcher.until(30, |e| matches!(e, Event::JobFinished { .. }));
+    // Each machine's scans as (start, end) times, from the events.
+    let mut started: BTreeMap<(String, String, String), u64> = BTreeMap::new();
+    let mut spans: Vec<(String, u64, u64)> = Vec::new();
+    for event in watcher.events() {
+        match event {
+            Event::ScanStarted {
+                machine,
+                scan,
+                at_unix_ms,
+                ..
+            } => {
+                started.insert((machine, scan.instance, scan.profile), at_unix_ms);
+            }
+            Event::ProfileDone {
+                machine,
+                scan,
+                at_unix_ms,
+                ..
+            } => {
+                let begin = started[&(machine.clone(), scan.instance, scan.profile)];
+                spans.push((machine, begin, at_unix_ms));
+            }
+            _ => {}
+        }
+    }
+    let on = |name: &str| spans.iter().filter(|s| s.0 == name).count();
+    assert!(
+        on("cmm1") >= 3 && on("cmm2") >= 3,
+        "both machines scan: {spans:?}"
+    );
+    let overlapping = spans.iter().any(|a| {
+        spans
+            .iter()
+            .any(|b| a.0 == "cmm1" && b.0 == "cmm2" && a.1 < b.2 && b.1 < a.2)
+    });
+    assert!(
+        overlapping,
+        "no two scans of the two machines overlapped: {spans:?}"
+    );
+    let (_, report) = station.report("SN-2");
+    let machines: Vec<&str> = report.machines.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(machines, ["cmm1", "cmm2"]);
+}
+
+#[test]
+fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_point() {
+    let mut station = Station::start("propeller.toml");
+    teach(&station);
+    // The same part inspected without a fault: the point count of every profile to expect.
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
+    let (_, clean) = station.report("SN-CLEAN");
+
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-3", "--detach"]);
+    // Mid-scan of the third profile.
+    let mut profiles_done = 0;
+    watcher.until(30, |e| {
+        if matches!(e, Event::ProfileDone { .. }) {
+            profiles_done += 1;
+        }
+        profiles_done >= 2 && matches!(e, Event::Point { index: 40, .. })
+    });
+    assert_eq!(
+        station.sim.control("fault cmm1 estop"),
+        "ok fault cmm1 estop"
+    );
+    let stopped = watcher.until(10, |e| matches!(e, Event::JobStopped { .. }));
+    let Event::JobStopped {
+        reason,
+        next_step,
+        machine,
+        ..
+    } = stopped
+    else {
+        unreachable!()
+    };
+    assert_eq!(machine.as_deref(), Some("cmm1"));
+    assert!(
+        reason.contains("0500") || reason.contains("mergency"),
+        "{reason}"
+    );
+    assert!(next_step.contains("zeroset clear"), "{next_step}");
+    let status = station.cli_ok(&["status"]);
+    assert!(status.contains("stopped"), "{status}");
+    // Nothing moves while the job waits.
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        !watcher
+            .events()
+            .iter()
+            .rev()
+            .take_while(|e| !matches!(e, Event::JobStopped { .. }))
+            .any(|e| matches!(e, Event::ScanStarted { .. })),
+        "a scan started before clear"
+    );
+    let cleared = station.cli_ok(&["clear"]);
+    assert!(cleared.contains("continues"), "{cleared}");
+    watcher.until(30, job_over);
+    let (dir, report) = station.report("SN-3");
+    assert_eq!(
+        point_counts(&report),
+        point_counts(&clean),
+        "every profile has one whole scan"
+    );
+    assert_no_repeated_points(&report);
+    // The cut scan is kept beside the job's scans, not deleted.
+    let job_scans = station.data().join("jobs").join(&report.job).join("scans");
+    let kept = std::fs::read_dir(&job_scans)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains(".cut-")
+        })
+        .count();
+    assert_eq!(kept, 1, "the cut scan is kept in {job_scans:?}");
+    assert!(dir.join("report.json").is_file());
+    station.kill_daemon();
+}
+
+#[test]
+fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
+    let mut station = Station::start("propeller.toml");
+    teach(&station);
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
+    let (_, clean) = station.report("SN-CLEAN");
+
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-4", "--detach"]);
+    let mut done_before = Vec::new();
+    watcher.until(30, |e| {
+        if let Event::ProfileDone { scan, .. } = e {
+            done_before.push(scan.clone());
+        }
+        done_before.len() >= 2 && matches!(e, Event::Point { index: 30, .. })
+    });
+    drop(watcher);
+    station.kill_daemon();
+    station.start_daemon();
+    let status = station.cli_ok(&["status"]);
+    assert!(
+        status.contains("stopped") && status.contains("daemon stopped"),
+        "{status}"
+    );
+
+    let mut watcher = station.watch();
+    let cleared = station.cli_ok(&["clear"]);
+    assert!(cleared.contains("continues"), "{cleared}");
+    watcher.until(60, job_over);
+    let rescanned: Vec<_> = watcher
+        .events()
+        .into_iter()
+        .filter_map(|e| match e {
+            Event::ScanStarted { scan, .. } => Some(scan),
+            _ => None,
+        })
+        .collect();
+    for done in &done_before {
+        assert!(
+            !rescanned.contains(done),
+            "{done:?} was complete before the kill but scanned again"
+        );
+    }
+    assert_eq!(rescanned.len() + done_before.len(), 15, "{rescanned:?}");
+    let (_, report) = station.report("SN-4");
+    assert_eq!(point_counts(&report), point_counts(&clean));
+    assert_no_repeated_points(&report);
+}
+
+#[test]
+fn two_watchers_receive_the_same_events() {
+    let station = Station::start("propeller.toml");
+    let mut first = station.watch();
+    let mut second = station.watch();
+    teach(&station);
+    first.until(30, job_over);
+    second.until(30, job_over);
+    assert!(first.seen.len() > 100, "{} events", first.seen.len());
+    assert_eq!(first.seen, second.seen);
+}
+
+#[test]
+fn operator_errors_say_what_to_do() {
+    let station = Station::start("propeller.toml");
+    let run = station.cli(&["inspect", "propeller", "--serial", "SN-5"]);
+    assert!(!run.success);
+    assert!(
+        run.stderr.contains("zeroset teach propeller"),
+        "{}",
+        run.stderr
+    );
+    let run = station.cli(&["teach", "no-such-part"]);
+    assert!(!run.success);
+    assert!(run.stderr.contains("no-such-part.toml"), "{}", run.stderr);
+    let run = station.cli(&["report", "SN-404"]);
+    assert!(
+        !run.success && run.stderr.contains("SN-404"),
+        "{}",
+        run.stderr
+    );
+    let run = station.cli(&["abort"]);
+    assert!(
+        !run.success && run.stderr.contains("no job"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn without_a_daemon_the_cli_says_how_to_start_one() {
+    let root = tempfile::tempdir().unwrap();
+    let text = zeroset::cli::demo::station_for_simulator(
+        std::path::Path::new(&crate::support::config("station.toml")),
+        &["cmm1".to_string()],
+        &root.path().join("ports"),
+        root.path(),
+    )
+    .unwrap();
+    let file = root.path().join("station.toml");
+    std::fs::write(&file, text).unwrap();
+    let run = crate::support::zeroset(&["status", "--config", &file.display().to_string()]);
+    assert!(!run.success);
+    assert!(run.stderr.contains("zeroset daemon"), "{}", run.stderr);
+}
