@@ -7,6 +7,7 @@
 use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
+use super::edges::SharpEdge;
 use super::reference::Reference;
 use crate::geometry::distance::{DistanceError, ExactDistance, Foot};
 use crate::geometry::implicit::IpModel;
@@ -27,6 +28,7 @@ pub struct ProfileGauge {
     x_mm: f64,
     model: IpModel<2>,
     samples: ZeroSetSamples<2>,
+    edges: Vec<SharpEdge>,
 }
 
 impl ProfileGauge {
@@ -51,6 +53,7 @@ impl ProfileGauge {
             x_mm: taught.x_mm,
             samples: ZeroSetSamples::new(&fitted.ip, &bounds, SAMPLING_CELLS),
             model: fitted.ip.clone(),
+            edges: taught.edges.clone(),
         }
     }
 
@@ -108,10 +111,17 @@ impl ScanGauge<'_> {
         // A point without a foot leaves the previous one in place: the next point still starts from a good foot.
         let foot = exact.foot(&in_plane, previous)?;
         self.previous = Some((in_plane, foot));
+        // Near a sharp edge the model cannot stand for the part (its zero set crosses itself there and goes on):
+        // there the distance is to the wedge of the edge's faces, and the nearest point reported is the edge.
+        let at_edge = self.gauge.edges.iter().find_map(|edge| {
+            edge.distance(&in_plane, &foot.point)
+                .map(|distance| (distance, Vector2::from(edge.apex)))
+        });
+        let (deviation_mm, nearest) = at_edge.unwrap_or((foot.distance, foot.point));
         Ok(PointDeviation {
-            deviation_mm: foot.distance,
+            deviation_mm,
             off_plane_mm,
-            foot: [self.gauge.x_mm, foot.point.x, foot.point.y],
+            foot: [self.gauge.x_mm, nearest.x, nearest.y],
         })
     }
 }

@@ -5,6 +5,7 @@
 //! master (hub axis z, master blade along +x, profiles in the planes x = const) before they reach a gauge here.
 
 pub mod deviation;
+pub mod edges;
 mod nominals;
 pub mod reference;
 pub mod stats;

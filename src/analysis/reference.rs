@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 mod file;
 
 pub use self::file::ReferenceFileError;
+use super::edges::{find_sharp_edges, SharpEdge};
 use super::nominals::thin_to_nominals;
 pub use super::nominals::NominalPoint;
 use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions, FitStats, Fitted};
@@ -67,6 +68,10 @@ pub struct ReferenceProfile {
     pub name: String,
     pub x_mm: f64,
     pub nominals: Vec<NominalPoint>,
+    /// The profile's sharp edges, found in the master's scan: within their normal cones a point's deviation is
+    /// its distance to the edge, not to the model (see `edges`).
+    #[serde(default)]
+    pub edges: Vec<SharpEdge>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -152,6 +157,7 @@ pub fn teach(
             name: p.name.clone(),
             x_mm: p.x_mm,
             nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
+            edges: profile_edges(p),
         })
         .collect();
     Ok(Reference {
@@ -248,6 +254,25 @@ fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackPro
             fit: Some(fitted.stats),
         },
     })
+}
+
+/// The sharp edges of a master profile, from its points and the probe's normals in the profile's plane.
+fn profile_edges(profile: &MasterProfile) -> Vec<SharpEdge> {
+    let points: Vec<Vector2<f64>> = profile
+        .points
+        .iter()
+        .map(|p| Vector2::new(p.y, p.z))
+        .collect();
+    let normals: Vec<Vector2<f64>> = profile
+        .normals
+        .iter()
+        .map(|n| Vector2::new(n.y, n.z).normalize())
+        .collect();
+    let edges = find_sharp_edges(&points, &normals);
+    for edge in &edges {
+        tracing::info!(profile = %profile.name, x_mm = profile.x_mm, apex_mm = ?edge.apex, turn_deg = edge.turn_rad.to_degrees(), "sharp edge");
+    }
+    edges
 }
 
 /// Whether `a` describes a closer fit than `b`: every point placed, then a smaller RMS. A sliver beside the data
