@@ -110,17 +110,19 @@ impl Pipeline {
                     let Some(profile) = active.get_mut(&key) else {
                         continue;
                     };
+                    // Published first, written right after: the write costs a system call that the watchers
+                    // need not wait for, and the point is in memory for the complete scan file either way.
+                    let event = self.measure(key, profile, raw, received_us);
+                    let _ = self.events.send(event);
                     if let Err(error) = profile.partial.push(&raw) {
                         active.remove(&key);
                         self.failed(key, error.to_string()).await;
                         continue;
                     }
-                    let event = self.measure(key, profile, raw, received_us);
-                    let _ = self.events.send(event);
                 }
                 PipelineMsg::End { key } => {
                     if let Some(profile) = active.remove(&key) {
-                        self.complete(key, profile).await;
+                        self.complete(key, profile);
                     }
                 }
                 PipelineMsg::Cut { key } => {
@@ -168,37 +170,42 @@ impl Pipeline {
         }
     }
 
-    /// Writes the complete scan; from then on the profile counts as done.
-    async fn complete(&self, key: ProfileKey, profile: Active<'_>) {
+    /// Writes the complete scan, then the profile counts as done. The write (flushed to the disk) runs on a
+    /// blocking thread of its own, so the next profile's points are measured and published meanwhile.
+    fn complete(&self, key: ProfileKey, profile: Active<'_>) {
         let file = ScanFile {
             header: profile.header.clone(),
             finished: clock::now_rfc3339(),
             points: profile.points,
         };
-        let points = file.points.len();
-        if let Err(error) = self.dir.write_scan(&self.scan_ref(key), &file) {
-            self.failed(key, error.to_string()).await;
-            return;
-        }
         let stats = profile.stats.summary();
         let verdict = stats.map(|s| self.tolerance.verdict(&s, profile.outside));
-        let _ = self.events.send(Event::ProfileDone {
-            job: self.job.clone(),
-            machine: profile.header.machine,
-            scan: self.scan_ref(key),
-            points,
-            stats,
-            verdict,
-            at_unix_ms: clock::unix_ms(),
+        let (machine, points) = (profile.header.machine, file.points.len());
+        let (dir, scan, job) = (self.dir.clone(), self.scan_ref(key), self.job.clone());
+        let (events, daemon) = (self.events.clone(), self.daemon.clone());
+        tokio::spawn(async move {
+            let written = {
+                let scan = scan.clone();
+                tokio::task::spawn_blocking(move || dir.write_scan(&scan, &file)).await
+            };
+            let result = match written {
+                Ok(Ok(())) => {
+                    let _ = events.send(Event::ProfileDone {
+                        job: job.clone(),
+                        machine,
+                        scan,
+                        points,
+                        stats,
+                        verdict,
+                        at_unix_ms: clock::unix_ms(),
+                    });
+                    Ok(())
+                }
+                Ok(Err(error)) => Err(error.to_string()),
+                Err(panic) => Err(format!("writing the scan failed: {panic}")),
+            };
+            let _ = daemon.send(DaemonMsg::Stored { job, key, result }).await;
         });
-        let _ = self
-            .daemon
-            .send(DaemonMsg::Stored {
-                job: self.job.clone(),
-                key,
-                result: Ok(()),
-            })
-            .await;
     }
 
     async fn failed(&self, key: ProfileKey, error: String) {

@@ -5,7 +5,7 @@
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdout, Command, Stdio};
-use std::sync::mpsc;
+use std::sync::{mpsc, OnceLock};
 use std::time::{Duration, Instant};
 
 use zeroset::api::{parse_line, Event, EventLine};
@@ -73,6 +73,28 @@ impl Station {
             );
             std::thread::sleep(Duration::from_millis(20));
         }
+    }
+
+    /// Gives this station the propeller's reference, taught once for all the tests that only inspect (teaching
+    /// is the slow part; the simulated propeller is the same in every simulator).
+    pub fn with_taught_reference(self) -> Station {
+        static TAUGHT: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+        let (_, taught) = TAUGHT.get_or_init(|| {
+            let teacher = Station::start("propeller.toml");
+            let out = teacher.cli_ok(&["teach", "propeller"]);
+            assert!(out.contains("reference saved"), "{out}");
+            let keep = tempfile::tempdir().expect("a temporary folder");
+            let file = keep.path().join("propeller.json");
+            std::fs::copy(teacher.reference(), &file).expect("the reference is copied");
+            (keep, file)
+        });
+        std::fs::create_dir_all(self.data().join("references")).expect("a references folder");
+        std::fs::copy(taught, self.reference()).expect("the reference is copied");
+        self
+    }
+
+    pub fn reference(&self) -> PathBuf {
+        self.data().join("references").join("propeller.json")
     }
 
     /// `kill -9`: no chance to tidy up.

@@ -27,44 +27,60 @@ fn the_readme_opens_with_the_example_and_the_test_command() {
     );
 }
 
-#[test]
-fn the_readme_example_runs_and_finds_blade_b_0_8_mm_inside() {
-    // Run the example's zeroset invocations with the binary under test, in order, as the README chains them.
-    let dir = tempfile::tempdir().unwrap();
-    let mut last = String::new();
-    for invocation in readme_commands()[0].split(" && ") {
-        let args: Vec<String> = invocation
-            .strip_prefix("cargo run --release -- ")
-            .expect("the example runs the zeroset binary")
-            .split_whitespace()
-            .map(|a| a.replace("/tmp/", &format!("{}/", dir.path().display())))
-            .collect();
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        last = zeroset_ok(&args);
-    }
-    let summary = last
+/// The RMS column of a blade's row in the demo's per-blade table.
+fn blade_rms(output: &str, blade: &str) -> f64 {
+    let row = output
         .lines()
-        .find(|l| l.trim_start().starts_with("n = 400, mean "))
-        .expect("a summary line");
-    let mean: f64 = summary
-        .split("mean ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!((mean + 0.8).abs() < 0.001, "{summary}");
-    assert!(summary.contains(" mm"), "units are stated: {summary}");
+        .find(|l| l.split_whitespace().next() == Some(blade))
+        .unwrap_or_else(|| panic!("no row for blade {blade}:\n{output}"));
+    row.split_whitespace().nth(3).unwrap().parse().unwrap()
+}
+
+#[test]
+fn the_readme_demo_teaches_and_inspects_the_simulated_propeller() {
+    let command = &readme_commands()[0];
+    let args: Vec<&str> = command
+        .strip_prefix("cargo run --release -- ")
+        .expect("the demo runs the zeroset binary")
+        .split_whitespace()
+        .collect();
+    let out = zeroset_ok(&args);
+    assert!(out.contains("reference saved"), "{out}");
+    assert!(
+        out.contains("mean mm") && out.contains("RMS mm"),
+        "units are stated:\n{out}"
+    );
+    // Blade A is the master: it reads the probe's noise. B and C are shifted 0.4 to 1.0 mm.
+    assert!(blade_rms(&out, "A") < 0.01, "{out}");
+    assert!(
+        blade_rms(&out, "B") > 0.3 && blade_rms(&out, "C") > 0.3,
+        "{out}"
+    );
+    let report = out
+        .lines()
+        .find_map(|l| l.strip_prefix("report: "))
+        .expect("the report's folder is printed");
+    assert!(
+        std::path::Path::new(report).join("report.json").is_file(),
+        "{report}"
+    );
 }
 
 #[test]
 fn help_describes_every_command_with_units() {
     let top = zeroset_ok(&["--help"]);
+    for command in [
+        "fit", "deviate", "sim", "demo", "daemon", "teach", "inspect", "watch", "status", "abort",
+        "clear", "report",
+    ] {
+        assert!(top.contains(command), "--help lacks {command}:\n{top}");
+    }
+    let inspect = zeroset_ok(&["inspect", "--help"]);
     assert!(
-        top.contains("fit") && top.contains("deviate") && top.contains("sim"),
-        "{top}"
+        inspect.contains("--serial")
+            && inspect.contains("--config")
+            && inspect.contains("--detach"),
+        "{inspect}"
     );
     let sim = zeroset_ok(&["sim", "--help"]);
     assert!(

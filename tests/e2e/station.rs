@@ -143,6 +143,14 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
                 profile.points.len()
             );
             let stats = &profile.stats;
+            // The agreement table (shown with --nocapture), for BENCHMARKS.md.
+            println!(
+                "{what}: mean {:+.5} mm (truth {mean:+.5}, off {:+.2} um), RMS {:.5} mm (truth {rms:.5}, off {:+.2} um)",
+                stats.mean_mm,
+                (stats.mean_mm - mean) * 1000.0,
+                stats.rms_mm,
+                (stats.rms_mm - rms) * 1000.0
+            );
             if (stats.mean_mm - mean).abs() >= AGREEMENT_MM
                 || (stats.rms_mm - rms).abs() >= AGREEMENT_MM
             {
@@ -173,9 +181,8 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
 
 #[test]
 fn two_machines_scan_profiles_at_the_same_time() {
-    let station = Station::start("two-machines.toml");
+    let station = Station::start("two-machines.toml").with_taught_reference();
     let mut watcher = station.watch();
-    teach(&station);
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-2"]);
     watcher.until(30, |e| matches!(e, Event::JobFinished { .. }));
     // Each machine's scans as (start, end) times, from the events.
@@ -224,8 +231,7 @@ fn two_machines_scan_profiles_at_the_same_time() {
 
 #[test]
 fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_point() {
-    let mut station = Station::start("propeller.toml");
-    teach(&station);
+    let mut station = Station::start("propeller.toml").with_taught_reference();
     // The same part inspected without a fault: the point count of every profile to expect.
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
     let (_, clean) = station.report("SN-CLEAN");
@@ -302,8 +308,7 @@ fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_
 
 #[test]
 fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
-    let mut station = Station::start("propeller.toml");
-    teach(&station);
+    let mut station = Station::start("propeller.toml").with_taught_reference();
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
     let (_, clean) = station.report("SN-CLEAN");
 
@@ -347,6 +352,34 @@ fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
     let (_, report) = station.report("SN-4");
     assert_eq!(point_counts(&report), point_counts(&clean));
     assert_no_repeated_points(&report);
+}
+
+#[test]
+fn an_abort_stops_the_job_and_frees_the_station_for_the_next() {
+    let station = Station::start("propeller.toml").with_taught_reference();
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-6", "--detach"]);
+    watcher.until(30, |e| matches!(e, Event::Point { index: 20, .. }));
+    let aborted = station.cli_ok(&["abort"]);
+    assert!(aborted.contains("aborted"), "{aborted}");
+    watcher.until(10, |e| matches!(e, Event::JobAborted { .. }));
+    // The daemon clears the machine after an operator's abort (no fault to remove) and takes the probe clear.
+    let mut status = station.cli_ok(&["status"]);
+    for _ in 0..100 {
+        if status.contains("machine cmm1: idle") {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+        status = station.cli_ok(&["status"]);
+    }
+    assert!(
+        status.contains("aborted") && status.contains("machine cmm1: idle"),
+        "{status}"
+    );
+    // The machine was cleared: the next job runs to its end.
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-7"]);
+    let (_, report) = station.report("SN-7");
+    assert_eq!(report.instances.len(), 3);
 }
 
 #[test]

@@ -1,0 +1,181 @@
+//! The station's figures, measured on the real programs: the simulator and the daemon over pseudo-terminals.
+//!
+//! - latency from a point's arrival on the line (its `received_unix_us`, stamped by the machine worker as the
+//!   point comes off the I++ client) to its deviation event at a subscriber of the control socket: p50, p99, max;
+//! - the whole inspection plan (15 profiles) on one machine and on two.
+//!
+//! Run: `cargo bench --bench station` (needs the release binary: cargo builds it for benches).
+
+use std::io::{BufRead, BufReader, Write};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use zeroset::api::{parse_line, to_line, Event, EventLine, Request, RequestLine};
+
+/// Machine seconds per second: fast enough to bench, slow enough that the machines, not the computer, set the
+/// pace (a scan's points arrive in blocks as they are measured).
+const TIME_SCALE: f64 = 20.0;
+
+struct Station {
+    root: PathBuf,
+    station: PathBuf,
+    children: Vec<Child>,
+}
+
+impl Drop for Station {
+    fn drop(&mut self) {
+        for child in &mut self.children {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        let _ = std::fs::remove_dir_all(&self.root);
+    }
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn start(sim_config: &str) -> Station {
+    let root = std::env::temp_dir().join(format!(
+        "zeroset-bench-{}-{}",
+        std::process::id(),
+        sim_config.replace('.', "-")
+    ));
+    std::fs::create_dir_all(&root).unwrap();
+    let ports = root.join("ports");
+    let mut sim = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        .args(["sim", "--config"])
+        .arg(repo().join("config/sims").join(sim_config))
+        .args(["--time-scale", &TIME_SCALE.to_string(), "--link-dir"])
+        .arg(&ports)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the simulator starts");
+    let mut out = BufReader::new(sim.stdout.take().unwrap());
+    let expected =
+        zeroset_sim::config::SimConfig::load(&repo().join("config/sims").join(sim_config))
+            .unwrap()
+            .machines
+            .len();
+    let mut machines = Vec::new();
+    while machines.len() < expected {
+        let mut line = String::new();
+        out.read_line(&mut line).unwrap();
+        if let Some((name, _)) = zeroset_sim::simulator::parse_announcement(&line) {
+            machines.push(name);
+        }
+    }
+    let text = zeroset::cli::demo::station_for_simulator(
+        &repo().join("config/station.toml"),
+        &machines,
+        &ports,
+        &root,
+    )
+    .unwrap();
+    let station = root.join("station.toml");
+    std::fs::write(&station, text).unwrap();
+    let daemon = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        .arg("daemon")
+        .arg("--config")
+        .arg(&station)
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the daemon starts");
+    let socket = root.join("zeroset.sock");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while UnixStream::connect(&socket).is_err() {
+        assert!(Instant::now() < deadline, "no daemon socket");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Station {
+        root,
+        station,
+        children: vec![sim, daemon],
+    }
+}
+
+fn cli(station: &Path, args: &[&str]) {
+    let status = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        .args(args)
+        .arg("--config")
+        .arg(station)
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "zeroset {args:?}");
+}
+
+fn now_us() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap()
+        .as_micros() as u64
+}
+
+/// Inspects a part while subscribed; returns each point's latency (us) and the plan's wall time.
+fn inspect(station: &Station, serial: &str) -> (Vec<u64>, Duration) {
+    let socket = station.root.join("zeroset.sock");
+    let mut events = UnixStream::connect(&socket).unwrap();
+    events
+        .write_all(to_line(&RequestLine::new(Request::Subscribe)).as_bytes())
+        .unwrap();
+    let mut lines = BufReader::new(events.try_clone().unwrap());
+    let mut line = String::new();
+    lines.read_line(&mut line).unwrap();
+    let started = Instant::now();
+    cli(
+        &station.station,
+        &["inspect", "propeller", "--serial", serial, "--detach"],
+    );
+    let mut latencies = Vec::new();
+    loop {
+        line.clear();
+        lines.read_line(&mut line).unwrap();
+        let arrived = now_us();
+        match parse_line::<EventLine>(line.trim()).unwrap().event {
+            Event::Point {
+                received_unix_us, ..
+            } => latencies.push(arrived.saturating_sub(received_unix_us)),
+            Event::JobFinished { .. } => return (latencies, started.elapsed()),
+            Event::JobStopped { reason, .. } | Event::JobFailed { error: reason, .. } => {
+                panic!("the inspection stopped: {reason}")
+            }
+            _ => {}
+        }
+    }
+}
+
+fn percentile(sorted: &[u64], p: f64) -> u64 {
+    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
+}
+
+fn main() {
+    // Criterion's harness flags (`--bench`) are ignored: this bench runs the station once per configuration.
+    let one = start("propeller.toml");
+    cli(&one.station, &["teach", "propeller"]);
+    let (mut latencies, one_machine) = inspect(&one, "BENCH-1");
+    drop(one);
+    latencies.sort_unstable();
+    println!(
+        "point -> deviation event at a subscriber: {} points, p50 {} us, p99 {} us, max {} us",
+        latencies.len(),
+        percentile(&latencies, 0.5),
+        percentile(&latencies, 0.99),
+        latencies.last().unwrap()
+    );
+
+    let two = start("two-machines.toml");
+    cli(&two.station, &["teach", "propeller"]);
+    let (_, two_machines) = inspect(&two, "BENCH-2");
+    drop(two);
+    let ratio = two_machines.as_secs_f64() / (one_machine.as_secs_f64() / 2.0);
+    println!(
+        "inspection plan (3 blades x 5 profiles, time scale {TIME_SCALE}): one machine {:.2} s, two machines {:.2} s = {ratio:.3} x half of one machine's",
+        one_machine.as_secs_f64(),
+        two_machines.as_secs_f64()
+    );
+}
