@@ -20,6 +20,9 @@ const STOP_CENTRE_OFF_START_MM: f64 = 1.0;
 /// only needs a point apart from the start).
 const HEADING_POINT_MM: f64 = 10.0;
 
+/// Nominals closer than this to a neighbour are one point of a sharp edge that the ball rolled around, mm.
+const EDGE_POINT_MM: f64 = 0.05;
+
 /// One scan of the plan: an instance's profile (indices into [`Plan::instance_names`] and
 /// [`Plan::profile_names`]). Ordered by instance, then profile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -229,11 +232,28 @@ impl Plan {
 
     /// The index of the non-empty `nominals`' point whose normal, on the instance in machine coordinates,
     /// points most nearly up (the first of equals).
+    ///
+    /// Nominals on a sharp edge are passed over (where the taught ball rolled around an edge, one point carries a
+    /// fan of normals, one of them straight up): a scan that starts on an edge approaches a tip, and sends its
+    /// hardest points to the analysis in one burst (seen as a 3 ms p99 latency of deviation events).
     fn upmost(&self, key: ProfileKey, nominals: &[NominalPoint]) -> usize {
         let placement = self.instance_to_machine(key.instance);
         let upness = |n: &NominalPoint| (placement * Vector3::from(n.normal)).normalize().z;
-        (1..nominals.len()).fold(0, |best, i| {
-            if upness(&nominals[i]) > upness(&nominals[best]) {
+        let count = nominals.len();
+        let on_edge = |i: usize| {
+            let here = Point3::from(nominals[i].point);
+            [(i + count - 1) % count, (i + 1) % count]
+                .iter()
+                .any(|&j| j != i && (Point3::from(nominals[j].point) - here).norm() < EDGE_POINT_MM)
+        };
+        let candidates: Vec<usize> = (0..count).filter(|&i| !on_edge(i)).collect();
+        let candidates = if candidates.is_empty() {
+            (0..count).collect()
+        } else {
+            candidates
+        };
+        candidates.into_iter().fold(usize::MAX, |best, i| {
+            if best == usize::MAX || upness(&nominals[i]) > upness(&nominals[best]) {
                 i
             } else {
                 best

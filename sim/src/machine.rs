@@ -41,6 +41,11 @@ impl Clock {
         }
     }
 
+    /// Machine time now.
+    pub fn now(&self) -> f64 {
+        self.machine(Instant::now())
+    }
+
     fn machine(&self, wall: Instant) -> f64 {
         wall.duration_since(self.epoch).as_secs_f64() * self.scale
     }

@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
+use std::sync::Arc;
 
 use tokio::io::{AsyncBufReadExt, BufReader};
 use tokio::signal::unix::{signal, SignalKind};
@@ -83,7 +84,7 @@ pub async fn run(
         senders.insert(machine.name.clone(), faults_in);
         let task = Machine {
             name: machine.name.clone(),
-            controller: Controller::new(machine, part),
+            controller: Controller::new(machine, part).with_clock(Arc::new(move || clock.now())),
             link,
             transcript,
             clock,

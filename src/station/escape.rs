@@ -176,9 +176,10 @@ mod tests {
         path.closed = false;
         let end = path.surface[199] + path.normals[199] * 1.0;
         let moves = way_out(end, Some(&path), 1.0, 2.0, 150.0).unwrap();
-        // Backwards through 200 degrees, not forwards through the unknown 160.
+        // Backwards through the 200 scanned degrees (y < 0, counter-clockwise from the top), not forwards through
+        // the unknown 160.
         let middle = moves[moves.len() / 2];
-        assert!(middle.y > 0.0, "goes back over the scanned side: {middle}");
+        assert!(middle.y < 0.0, "goes back over the scanned side: {middle}");
     }
 
     #[test]

@@ -11,7 +11,7 @@
 //! ```
 
 use std::fs::{self, File, OpenOptions};
-use std::io::{self, BufRead, BufReader, Write};
+use std::io::{self, BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -138,7 +138,10 @@ impl JobDir {
             "{}",
             serde_json::to_string(header).expect("a header serialises")
         )?;
-        Ok(PartialScan { file, path })
+        Ok(PartialScan {
+            file: BufWriter::new(file),
+            path,
+        })
     }
 
     /// The points of a profile's partial file, if one is there (the scan that was running when the job stopped).
@@ -207,21 +210,29 @@ impl JobDir {
 
 /// The points of a profile being scanned, appended as they arrive.
 pub struct PartialScan {
-    file: File,
+    file: BufWriter<File>,
     path: PathBuf,
 }
 
 impl PartialScan {
-    /// Appends one point; it is in the operating system's hands when this returns, so a killed daemon keeps it.
+    /// Appends one point to the buffer; [`PartialScan::flush`] hands what was appended to the operating system.
     pub fn push(&mut self, point: &RawPoint) -> io::Result<()> {
-        let mut line = serde_json::to_string(point).expect("a point serialises");
-        line.push('\n');
-        self.file.write_all(line.as_bytes()).map_err(|e| {
-            io::Error::new(
-                e.kind(),
-                format!("cannot write {}: {e}", self.path.display()),
-            )
-        })
+        serde_json::to_writer(&mut self.file, point)
+            .map_err(io::Error::from)
+            .and_then(|()| self.file.write_all(b"\n"))
+            .map_err(|e| self.error(e))
+    }
+
+    /// Hands the appended points to the operating system, so that a killed daemon keeps them.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.file.flush().map_err(|e| self.error(e))
+    }
+
+    fn error(&self, e: io::Error) -> io::Error {
+        io::Error::new(
+            e.kind(),
+            format!("cannot write {}: {e}", self.path.display()),
+        )
     }
 }
 
@@ -306,6 +317,7 @@ mod tests {
         let mut partial = dir.start_partial(&scan, &header).unwrap();
         partial.push(&point(1.0)).unwrap();
         partial.push(&point(2.0)).unwrap();
+        partial.flush().unwrap();
         assert!(dir.completed().unwrap().is_empty());
         let (read_header, points) = dir.read_partial(&scan).unwrap().unwrap();
         assert_eq!((read_header, points.len()), (header.clone(), 2));
@@ -353,6 +365,7 @@ mod tests {
         let mut partial = dir.start_partial(&scan, &header).unwrap();
         partial.push(&point(1.0)).unwrap();
         partial.file.write_all(b"{\"centre\":[1.0,").unwrap();
+        partial.flush().unwrap();
         let (_, points) = dir.read_partial(&scan).unwrap().unwrap();
         assert_eq!(points, vec![point(1.0)]);
     }

@@ -10,6 +10,7 @@ mod finish;
 mod job;
 mod journal;
 mod pipeline;
+mod recorder;
 mod worker;
 
 use tokio::sync::{broadcast, mpsc, oneshot};

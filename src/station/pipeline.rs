@@ -1,7 +1,8 @@
-//! A job's analysis, off the machine workers: every point a worker forwards is written to its profile's partial
-//! file, compensated for the probe ball, measured against the reference (when inspecting) and published at once;
-//! when a profile's scan ends its points are written as a complete scan file and only then does the profile count
-//! as done. The queue from the workers is bounded, so a stalled disk slows scanning down rather than losing points.
+//! A job's analysis, off the machine workers: every point a worker forwards is compensated for the probe ball,
+//! measured against the reference (when inspecting), published at once, and handed to the job's recorder, which
+//! writes it to disk on its own thread; when a profile's scan ends the recorder writes its scan file, and only then
+//! does the profile count as done. The queue from the workers is bounded, so analysis that falls behind slows
+//! scanning down rather than losing points.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -10,7 +11,8 @@ use nalgebra::{Isometry3, Point3};
 use tokio::sync::{broadcast, mpsc};
 
 use super::clock;
-use super::journal::{JobDir, PartialScan, ScanFile, ScanHeader};
+use super::journal::{JobDir, ScanHeader};
+use super::recorder::{Record, Recorder};
 use super::DaemonMsg;
 use crate::analysis::deviation::{ProfileGauge, ScanGauge};
 use crate::analysis::stats::{RunningStats, Tolerance};
@@ -29,6 +31,9 @@ pub enum PipelineMsg {
         key: ProfileKey,
         machine: String,
         ball_radius_mm: f64,
+        /// Where on the surface the scan begins, machine coordinates: the gauge finds the model's nearest point
+        /// there while the machine approaches, so the first point is measured as fast as the rest.
+        entry: Point3<f64>,
     },
     Point {
         key: ProfileKey,
@@ -56,7 +61,6 @@ pub struct Pipeline {
 /// A profile being scanned.
 struct Active<'g> {
     header: ScanHeader,
-    partial: PartialScan,
     points: Vec<RawPoint>,
     machine_to_part: Isometry3<f64>,
     gauge: Option<ScanGauge<'g>>,
@@ -66,41 +70,53 @@ struct Active<'g> {
 
 impl Pipeline {
     pub async fn run(self, mut inbox: mpsc::Receiver<PipelineMsg>) {
+        let recorder = Recorder {
+            job: self.job.clone(),
+            dir: self.dir.clone(),
+            events: self.events.clone(),
+            daemon: self.daemon.clone(),
+        }
+        .spawn();
         let gauges = self.gauges.clone();
         let mut active: HashMap<ProfileKey, Active<'_>> = HashMap::new();
         while let Some(message) = inbox.recv().await {
+            // The recorder lives as long as this task; a send fails only if its thread panicked, which the
+            // daemon learns from the profiles that never count as done.
             match message {
                 PipelineMsg::Start {
                     key,
                     machine,
                     ball_radius_mm,
+                    entry,
                 } => {
                     let header = ScanHeader {
                         machine,
                         ball_radius_mm,
                         started: clock::now_rfc3339(),
                     };
-                    match self.dir.start_partial(&self.scan_ref(key), &header) {
-                        Ok(partial) => {
-                            let gauge = gauges.as_deref().map(|g| g[key.profile].scan());
-                            active.insert(
-                                key,
-                                Active {
-                                    header,
-                                    partial,
-                                    points: Vec::new(),
-                                    machine_to_part: self
-                                        .plan
-                                        .instance_to_machine(key.instance)
-                                        .inverse(),
-                                    gauge,
-                                    stats: RunningStats::default(),
-                                    outside: 0,
-                                },
-                            );
-                        }
-                        Err(error) => self.failed(key, error.to_string()).await,
+                    let scan = self.scan_ref(key);
+                    let _ = recorder.send(Record::Start {
+                        key,
+                        scan,
+                        header: header.clone(),
+                    });
+                    let machine_to_part = self.plan.instance_to_machine(key.instance).inverse();
+                    let mut gauge = gauges.as_deref().map(|g| g[key.profile].scan());
+                    if let Some(gauge) = gauge.as_mut() {
+                        // Without a neighbour's foot to start from, a point needs the gauge's full search.
+                        let _ = gauge.measure(&(machine_to_part * entry));
                     }
+                    active.insert(
+                        key,
+                        Active {
+                            header,
+                            points: Vec::new(),
+                            machine_to_part,
+                            gauge,
+                            stats: RunningStats::default(),
+                            outside: 0,
+                        },
+                    );
                 }
                 PipelineMsg::Point {
                     key,
@@ -110,23 +126,24 @@ impl Pipeline {
                     let Some(profile) = active.get_mut(&key) else {
                         continue;
                     };
-                    // Published first, written right after: the write costs a system call that the watchers
-                    // need not wait for, and the point is in memory for the complete scan file either way.
                     let event = self.measure(key, profile, raw, received_us);
                     let _ = self.events.send(event);
-                    if let Err(error) = profile.partial.push(&raw) {
-                        active.remove(&key);
-                        self.failed(key, error.to_string()).await;
-                        continue;
-                    }
+                    let _ = recorder.send(Record::Point { key, raw });
                 }
                 PipelineMsg::End { key } => {
                     if let Some(profile) = active.remove(&key) {
-                        self.complete(key, profile);
+                        let stats = profile.stats.summary();
+                        let _ = recorder.send(Record::End {
+                            key,
+                            points: profile.points,
+                            verdict: stats.map(|s| self.tolerance.verdict(&s, profile.outside)),
+                            stats,
+                        });
                     }
                 }
                 PipelineMsg::Cut { key } => {
                     active.remove(&key);
+                    let _ = recorder.send(Record::Cut { key });
                 }
             }
         }
@@ -168,55 +185,6 @@ impl Pipeline {
             deviation_mm: deviation,
             received_unix_us: received_us,
         }
-    }
-
-    /// Writes the complete scan, then the profile counts as done. The write (flushed to the disk) runs on a
-    /// blocking thread of its own, so the next profile's points are measured and published meanwhile.
-    fn complete(&self, key: ProfileKey, profile: Active<'_>) {
-        let file = ScanFile {
-            header: profile.header.clone(),
-            finished: clock::now_rfc3339(),
-            points: profile.points,
-        };
-        let stats = profile.stats.summary();
-        let verdict = stats.map(|s| self.tolerance.verdict(&s, profile.outside));
-        let (machine, points) = (profile.header.machine, file.points.len());
-        let (dir, scan, job) = (self.dir.clone(), self.scan_ref(key), self.job.clone());
-        let (events, daemon) = (self.events.clone(), self.daemon.clone());
-        tokio::spawn(async move {
-            let written = {
-                let scan = scan.clone();
-                tokio::task::spawn_blocking(move || dir.write_scan(&scan, &file)).await
-            };
-            let result = match written {
-                Ok(Ok(())) => {
-                    let _ = events.send(Event::ProfileDone {
-                        job: job.clone(),
-                        machine,
-                        scan,
-                        points,
-                        stats,
-                        verdict,
-                        at_unix_ms: clock::unix_ms(),
-                    });
-                    Ok(())
-                }
-                Ok(Err(error)) => Err(error.to_string()),
-                Err(panic) => Err(format!("writing the scan failed: {panic}")),
-            };
-            let _ = daemon.send(DaemonMsg::Stored { job, key, result }).await;
-        });
-    }
-
-    async fn failed(&self, key: ProfileKey, error: String) {
-        let _ = self
-            .daemon
-            .send(DaemonMsg::Stored {
-                job: self.job.clone(),
-                key,
-                result: Err(error),
-            })
-            .await;
     }
 
     fn scan_ref(&self, key: ProfileKey) -> ScanRef {

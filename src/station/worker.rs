@@ -368,23 +368,29 @@ impl Worker {
                 self.entry.name
             ),
         })?;
+        // The pipeline opens the profile's partial file while the machine starts the scan, not while the first
+        // points wait (opening a file costs most of a millisecond).
+        let pipeline = order.pipeline.clone();
+        let start = PipelineMsg::Start {
+            key: order.key,
+            machine: self.entry.name.clone(),
+            ball_radius_mm: radius,
+            entry: order.path.surface[order.path.entry],
+        };
+        if pipeline.send(start).await.is_err() {
+            return Err(self.pipeline_gone());
+        }
         let started = match &order.scan {
             Scan::InPlane(plan) => scanning.scan_in_plane(plan.clone()).await,
             Scan::Curve(plan) => scanning.scan_on_curve(plan.clone()).await,
         };
         let stream = match started {
             Ok(stream) => stream,
-            Err(error) => return Err(self.fail(error)),
+            Err(error) => {
+                let _ = pipeline.send(PipelineMsg::Cut { key: order.key }).await;
+                return Err(self.fail(error));
+            }
         };
-        let pipeline = order.pipeline.clone();
-        let start = PipelineMsg::Start {
-            key: order.key,
-            machine: self.entry.name.clone(),
-            ball_radius_mm: radius,
-        };
-        if pipeline.send(start).await.is_err() {
-            return Err(self.pipeline_gone());
-        }
         let streamed = self.stream(stream, &order, radius).await;
         let end = match &streamed {
             Ok(()) => PipelineMsg::End { key: order.key },

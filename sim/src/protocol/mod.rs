@@ -94,6 +94,10 @@ pub struct Controller {
     queue: VecDeque<Command>,
     running: Option<Running>,
     daemon: Option<MoveDaemon>,
+    /// The machine time now, when the controller runs against a clock: a command's motion then starts once its
+    /// plan is computed, as a real controller's does, instead of at its arrival (a long scan's planning would
+    /// otherwise send the points due meanwhile in one burst).
+    clock: Option<Arc<dyn Fn() -> f64 + Send + Sync>>,
 }
 
 impl Controller {
@@ -125,7 +129,14 @@ impl Controller {
             queue: VecDeque::new(),
             running: None,
             daemon: None,
+            clock: None,
         }
+    }
+
+    /// The controller on a clock of machine time (see the `clock` field).
+    pub fn with_clock(mut self, clock: Arc<dyn Fn() -> f64 + Send + Sync>) -> Self {
+        self.clock = Some(clock);
+        self
     }
 
     /// Where the probe centre is at machine time `now`.
@@ -360,6 +371,7 @@ impl Controller {
         let tag = command.tag();
         let name = command.name().as_str().to_owned();
         let plan = self.plan(&command);
+        let now = self.clock.as_ref().map_or(now, |clock| clock().max(now));
         if let Some(daemon) = &mut self.daemon {
             daemon.next_tick = daemon.next_tick.max(now);
         }
