@@ -13,7 +13,8 @@ use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::machine::{
     CurveScan, Error as MachineError, Event, InPlaneScan, Machine, ScanStream, Speeds, Xyz,
 };
-use zeroset_drivers::transport::{open_pty, open_serial, SerialConfig};
+use zeroset_drivers::transport::SerialConfig;
+use zeroset_drivers::transport::{open_pty, open_serial};
 
 use super::escape::{way_out, KnownPath};
 
@@ -61,8 +62,14 @@ pub struct WorkerHandle {
     pub name: String,
     pub orders: mpsc::Sender<Order>,
     /// The machine's link, to abort a scan from outside the worker.
-    link: Arc<Mutex<Option<Client>>>,
+    link: Arc<Mutex<Option<Link>>>,
 }
+
+/// A machine as the worker drives it: the I++ client on a line, or a mock in the tests.
+pub type Link = Arc<dyn Machine>;
+
+/// Opens a machine's link (again, after it was lost).
+pub type Connector = Box<dyn Fn() -> Result<Link, WorkerError> + Send + Sync>;
 
 impl WorkerHandle {
     /// Stops all motion now (I++ `AbortE` jumps the machine's queue); the running order ends with an error.
@@ -76,9 +83,21 @@ impl WorkerHandle {
     }
 }
 
-/// Starts the worker of one machine.
+/// Starts the worker of one machine on its serial line or pseudo-terminal.
 pub fn spawn(
     entry: MachineEntry,
+    probe: ProbeSettings,
+    safety: Safety,
+    daemon: mpsc::Sender<DaemonMsg>,
+) -> WorkerHandle {
+    let name = entry.name.clone();
+    spawn_on(name, line_connector(entry), probe, safety, daemon)
+}
+
+/// Starts the worker of the machine named `name`, reached through `connect`.
+pub fn spawn_on(
+    name: String,
+    connect: Connector,
     probe: ProbeSettings,
     safety: Safety,
     daemon: mpsc::Sender<DaemonMsg>,
@@ -86,12 +105,13 @@ pub fn spawn(
     let (orders, inbox) = mpsc::channel(4);
     let link = Arc::new(Mutex::new(None));
     let handle = WorkerHandle {
-        name: entry.name.clone(),
+        name: name.clone(),
         orders,
         link: link.clone(),
     };
     let worker = Worker {
-        entry,
+        name,
+        connect,
         probe,
         safety,
         link,
@@ -105,11 +125,37 @@ pub fn spawn(
     handle
 }
 
+/// The I++ client on the machine's configured line.
+fn line_connector(entry: MachineEntry) -> Connector {
+    Box::new(move || {
+        let port = entry.port.to_string_lossy().into_owned();
+        let config = ClientConfig {
+            ack_timeout: Duration::from_secs_f64(entry.ack_timeout_s),
+            reply_timeout: Duration::from_secs_f64(entry.reply_timeout_s),
+        };
+        let line = match entry.baud {
+            Some(baud) => open_serial(&SerialConfig {
+                path: port.clone(),
+                baud,
+            }),
+            None => open_pty(&port),
+        };
+        let line = line.map_err(|e| WorkerError {
+            message: format!(
+                "machine {}: cannot open its line {port}: {e}; check the cable and that the controller is on, then run `zeroset clear`",
+                entry.name
+            ),
+        })?;
+        Ok(Arc::new(Client::new(&entry.name, line, config)) as Link)
+    })
+}
+
 struct Worker {
-    entry: MachineEntry,
+    name: String,
+    connect: Connector,
     probe: ProbeSettings,
     safety: Safety,
-    link: Arc<Mutex<Option<Client>>>,
+    link: Arc<Mutex<Option<Link>>>,
     /// What the machine reported outside the commands (an emergency stop, an alarm) since the link opened.
     alarms: Option<broadcast::Receiver<Event>>,
     /// Whether this worker holds an I++ session on the current link.
@@ -152,7 +198,7 @@ impl Worker {
                         self.ball_radius = None;
                     }
                     let report = DaemonMsg::ScanEnded {
-                        machine: self.entry.name.clone(),
+                        machine: self.name.clone(),
                         key,
                         result,
                     };
@@ -172,34 +218,16 @@ impl Worker {
         }
     }
 
-    fn client(&self) -> Option<Client> {
+    fn client(&self) -> Option<Link> {
         self.link.lock().expect("not poisoned").clone()
     }
 
     /// The machine's link, opened if it is not.
-    fn connect(&mut self) -> Result<Client, WorkerError> {
+    fn connect(&mut self) -> Result<Link, WorkerError> {
         if let Some(client) = self.client() {
             return Ok(client);
         }
-        let port = self.entry.port.to_string_lossy().into_owned();
-        let config = ClientConfig {
-            ack_timeout: Duration::from_secs_f64(self.entry.ack_timeout_s),
-            reply_timeout: Duration::from_secs_f64(self.entry.reply_timeout_s),
-        };
-        let client = match self.entry.baud {
-            Some(baud) => open_serial(&SerialConfig {
-                path: port.clone(),
-                baud,
-            })
-            .map(|line| Client::new(&self.entry.name, line, config)),
-            None => open_pty(&port).map(|line| Client::new(&self.entry.name, line, config)),
-        }
-        .map_err(|e| WorkerError {
-            message: format!(
-                "machine {}: cannot open its line {port}: {e}; check the cable and that the controller is on, then run `zeroset clear`",
-                self.entry.name
-            ),
-        })?;
+        let client = (self.connect)()?;
         self.alarms = Some(client.events());
         *self.link.lock().expect("not poisoned") = Some(client.clone());
         Ok(client)
@@ -252,7 +280,7 @@ impl Worker {
     /// Starts a session on the link unless this worker holds one. A controller may still hold the session of a
     /// daemon that was killed (it answers StartSession with a protocol error): that session is ended and a new
     /// one started, which also clears the machine's errors.
-    async fn open_session(&mut self, client: &Client) -> Result<(), WorkerError> {
+    async fn open_session(&mut self, client: &Link) -> Result<(), WorkerError> {
         if self.session {
             return Ok(());
         }
@@ -263,7 +291,7 @@ impl Worker {
                     .device_error()
                     .is_some_and(|e| e.code() == PROTOCOL_ERROR) =>
             {
-                tracing::warn!(machine = %self.entry.name, "taking over a session left open on the machine");
+                tracing::warn!(machine = %self.name, "taking over a session left open on the machine");
                 let _ = client.end_session().await;
                 client.start_session().await.map_err(|e| self.fail(e))?;
             }
@@ -274,7 +302,7 @@ impl Worker {
     }
 
     /// Session, homing, tool and speeds: what the station needs before the first motion. Returns the ball radius.
-    async fn prepare(&mut self) -> Result<(Client, f64), WorkerError> {
+    async fn prepare(&mut self) -> Result<(Link, f64), WorkerError> {
         let client = self.connect()?;
         if let Some(radius) = self.ball_radius {
             return Ok((client, radius));
@@ -299,7 +327,7 @@ impl Worker {
             return Err(WorkerError {
                 message: format!(
                     "machine {}: tool {} has a ball radius of {radius} mm, outside (0, {}] mm allowed by the station's safety settings; qualify or change the tool",
-                    self.entry.name, self.probe.tool, self.safety.max_ball_radius_mm
+                    self.name, self.probe.tool, self.safety.max_ball_radius_mm
                 ),
             });
         }
@@ -308,7 +336,7 @@ impl Worker {
     }
 
     /// Takes the probe from wherever it is to the clearance height without crossing the part.
-    async fn leave(&self, client: &Client) -> Result<Point3<f64>, WorkerError> {
+    async fn leave(&self, client: &Link) -> Result<Point3<f64>, WorkerError> {
         let here = client.position().await?;
         let here = Point3::new(here.x, here.y, here.z);
         let radius = self.ball_radius.unwrap_or(self.safety.max_ball_radius_mm);
@@ -322,7 +350,7 @@ impl Worker {
         .map_err(|e| WorkerError {
             message: format!(
                 "machine {}: {e}; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
-                self.entry.name, self.safety.clearance_z_mm
+                self.name, self.safety.clearance_z_mm
             ),
         })?;
         let mut at = here;
@@ -365,7 +393,7 @@ impl Worker {
         let scanning = client.scanning().ok_or_else(|| WorkerError {
             message: format!(
                 "machine {}: its probe cannot scan; this station needs a scanning probe",
-                self.entry.name
+                self.name
             ),
         })?;
         // The pipeline opens the profile's partial file while the machine starts the scan, not while the first
@@ -373,7 +401,7 @@ impl Worker {
         let pipeline = order.pipeline.clone();
         let start = PipelineMsg::Start {
             key: order.key,
-            machine: self.entry.name.clone(),
+            machine: self.name.clone(),
             ball_radius_mm: radius,
             entry: order.path.surface[order.path.entry],
         };
@@ -453,7 +481,7 @@ impl Worker {
         WorkerError {
             message: format!(
                 "machine {}: the job's analysis stopped; the scan was not recorded",
-                self.entry.name
+                self.name
             ),
         }
     }
@@ -462,3 +490,6 @@ impl Worker {
 fn xyz(p: &Point3<f64>) -> Xyz {
     Xyz::new(p.x, p.y, p.z)
 }
+
+#[cfg(test)]
+mod tests;
