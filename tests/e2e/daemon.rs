@@ -141,6 +141,8 @@ impl Station {
             .arg(&self.station_file)
             .current_dir(repo())
             .stdout(Stdio::piped())
+            // A watcher says so when its daemon is killed, as some tests do on purpose.
+            .stderr(Stdio::null())
             .spawn()
             .expect("zeroset watch starts");
         let stdout = child.stdout.take().expect("piped");

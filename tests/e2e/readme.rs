@@ -29,9 +29,13 @@ fn the_readme_opens_with_the_example_and_the_test_command() {
 
 /// The RMS column of a blade's row in the demo's per-blade table.
 fn blade_rms(output: &str, blade: &str) -> f64 {
+    // The table's row: the blade's name, then its point count (the live lines name a profile second).
     let row = output
         .lines()
-        .find(|l| l.split_whitespace().next() == Some(blade))
+        .find(|l| {
+            let mut words = l.split_whitespace();
+            words.next() == Some(blade) && words.next().is_some_and(|w| w.parse::<usize>().is_ok())
+        })
         .unwrap_or_else(|| panic!("no row for blade {blade}:\n{output}"));
     row.split_whitespace().nth(3).unwrap().parse().unwrap()
 }
