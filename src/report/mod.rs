@@ -2,6 +2,7 @@
 //! which distance and compensation, every point with its deviation, the statistics and the verdicts. One folder
 //! per part holds report.json (everything), deviations.csv (one row per point) and summary.txt (for the operator).
 
+mod store;
 mod summary;
 mod writers;
 
@@ -11,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::geometry::fit3l::FitMethod;
+pub use store::{ProfileRecord, Store, StoreError, STORE_FILE};
 pub use summary::summary_text;
 pub use writers::{write_report, DEVIATIONS_FILE, REPORT_FILE, SUMMARY_FILE};
 

@@ -72,7 +72,7 @@ fn instance(name: &str, base: f64, excess: usize) -> InstanceReport {
     }
 }
 
-fn sample_report() -> PartReport {
+pub(super) fn sample_report() -> PartReport {
     let instances = vec![instance("blade-A", 0.004, 0), instance("blade-B", -0.02, 2)];
     PartReport {
         format: FORMAT.to_string(),

@@ -1,9 +1,8 @@
 //! The daemon's state: the machines, the job, and every decision about them. One task owns it and handles one
 //! message at a time, so no decision races another.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::SystemTime;
 
 use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc, oneshot};
@@ -358,6 +357,7 @@ impl Daemon {
                     gauges: &gauges,
                     tolerance,
                     reports: &config.folders.reports,
+                    store: &store_path(&config),
                 }),
                 _ => finish::fit_reference(&plan, &dir, &path),
             };
@@ -646,40 +646,33 @@ fn phase_name(phase: &Phase) -> String {
     }
 }
 
-/// The newest report of a serial number, as the operator reads it.
-fn report(config: &StationConfig, serial: &str) -> Reply {
-    match latest_report_dir(&config.folders.reports, serial) {
-        Some(dir) => match crate::report::read_report(&dir) {
-            Ok(report) => Reply::Report {
-                summary: crate::report::summary_text(&report),
-                dir,
-            },
-            Err(error) => Reply::Error {
-                message: error.to_string(),
-            },
-        },
-        None => Reply::Error {
-            message: format!(
-                "no report for serial {serial} under {}; inspect it with `zeroset inspect PART --serial {serial}`",
-                config.folders.reports.display()
-            ),
-        },
-    }
+/// The inspection history's database file.
+fn store_path(config: &StationConfig) -> PathBuf {
+    config.folders.data.join(crate::report::STORE_FILE)
 }
 
-/// The folder of the newest report of `serial`: REPORTS/PART/SERIAL/JOB, newest by the job's start.
-fn latest_report_dir(reports: &Path, serial: &str) -> Option<PathBuf> {
-    let mut found: Vec<(SystemTime, PathBuf)> = Vec::new();
-    for part in std::fs::read_dir(reports).ok()?.flatten() {
-        let Ok(jobs) = std::fs::read_dir(part.path().join(serial)) else {
-            continue;
-        };
-        for job in jobs.flatten() {
-            let report = job.path().join(crate::report::REPORT_FILE);
-            if let Ok(modified) = report.metadata().and_then(|m| m.modified()) {
-                found.push((modified, job.path()));
-            }
-        }
+/// The newest report of a serial number, as the operator reads it.
+fn report(config: &StationConfig, serial: &str) -> Reply {
+    let found = crate::report::Store::open(&store_path(config))
+        .and_then(|store| store.latest_report(serial))
+        .map_err(|e| e.to_string())
+        .and_then(|dir| {
+            dir.ok_or_else(|| {
+                format!(
+                    "no inspection of serial {serial} in the history; inspect it with `zeroset inspect PART --serial {serial}`"
+                )
+            })
+        });
+    let read = found.and_then(|dir| {
+        crate::report::read_report(&dir)
+            .map(|report| (dir, report))
+            .map_err(|e| e.to_string())
+    });
+    match read {
+        Ok((dir, report)) => Reply::Report {
+            summary: crate::report::summary_text(&report),
+            dir,
+        },
+        Err(message) => Reply::Error { message },
     }
-    found.into_iter().max().map(|(_, dir)| dir)
 }

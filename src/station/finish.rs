@@ -18,6 +18,7 @@ use crate::api::{InstanceSummary, JobKind, ProfileFit};
 use crate::plan::Plan;
 use crate::report::{
     write_report, InstanceReport, MachineUse, PartReport, PointRecord, ProfileReport, ReferenceUse,
+    Store,
 };
 
 /// How a finished job ended.
@@ -108,6 +109,8 @@ pub struct ReportInputs<'a> {
     pub gauges: &'a [ProfileGauge],
     pub tolerance: Tolerance,
     pub reports: &'a Path,
+    /// The inspection history's database file.
+    pub store: &'a Path,
 }
 
 /// Measures every scanned point against the reference and writes the part's report folder.
@@ -222,6 +225,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         .join(&inputs.record.id);
     write_report(&folder, &report).map_err(|e| e.to_string())?;
     copy_scans(dir, &folder).map_err(|e| e.to_string())?;
+    // Last: once the history holds the inspection, it is done (the daemon then closes its journal; a daemon killed
+    // in between finishes the job again, and the history replaces the entry of the same job).
+    Store::open(inputs.store)
+        .and_then(|mut store| store.record(&report, &folder))
+        .map_err(|e| e.to_string())?;
     let summaries = report
         .instances
         .iter()
