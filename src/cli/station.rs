@@ -70,10 +70,28 @@ pub struct StatusArgs {
 
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// The part's serial number.
-    pub serial: String,
+    /// The part's serial number: prints its newest report's summary and folder.
+    #[arg(required_unless_present_any = ["trend", "export"])]
+    pub serial: Option<String>,
+    /// Per profile of each instance, the mean deviation over the last parts, its spread, Cp and Cpk (mm).
+    #[arg(long, conflicts_with = "serial")]
+    pub trend: bool,
+    /// The inspection history as CSV on standard output, for spreadsheets.
+    #[arg(long, value_enum, conflicts_with = "serial")]
+    pub export: Option<ExportFormat>,
+    /// The part type of the trend or the export (a part file's name).
+    #[arg(long, default_value = "propeller")]
+    pub part_type: String,
+    /// How many of the newest inspections the trend or the export covers.
+    #[arg(long, default_value_t = 50)]
+    pub last: usize,
     #[command(flatten)]
     pub station: StationFile,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum ExportFormat {
+    Csv,
 }
 
 /// The control socket of a station file.
@@ -250,8 +268,11 @@ pub fn simple(station: &StationFile, request: Request) -> anyhow::Result<()> {
 }
 
 pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
+    let Some(serial) = &args.serial else {
+        return history(args);
+    };
     let request = Request::Report {
-        serial: args.serial.clone(),
+        serial: serial.clone(),
     };
     match accepted(connect(&args.station)?.request(request)?)? {
         Reply::Report { dir, summary } => {
@@ -261,4 +282,35 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
         }
         other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
     }
+}
+
+/// `--trend` and `--export`: read from the history's database directly (no daemon needed).
+fn history(args: &ReportArgs) -> anyhow::Result<()> {
+    use crate::report::{history_csv, trend, trend_text, Store, STORE_FILE};
+    let config = StationConfig::load(&args.station.config)?;
+    let store = Store::open(&config.folders.data.join(STORE_FILE))?;
+    let history = store.profile_history(&args.part_type, args.last)?;
+    anyhow::ensure!(
+        !history.is_empty(),
+        "no inspection of part type {} in the history yet; inspect parts with `zeroset inspect {} --serial SN`",
+        args.part_type,
+        args.part_type
+    );
+    if args.export.is_some() {
+        print!("{}", history_csv(&history));
+        return Ok(());
+    }
+    let newest = history.last().expect("not empty");
+    let (lower, upper) = (newest.lower_mm, newest.upper_mm);
+    let parts = history
+        .iter()
+        .map(|r| (&r.serial, &r.finished))
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    println!("{} trend: the last {parts} inspections", args.part_type);
+    print!(
+        "{}",
+        trend_text(&trend(&history, lower, upper), lower, upper)
+    );
+    Ok(())
 }

@@ -135,6 +135,8 @@ impl Watch {
                 self.line(instance_table(instances));
                 if let Some(report) = report {
                     self.line(format!("report: {}", report.display()));
+                    let html = report.join(crate::report::HTML_FILE);
+                    self.line(format!("open in a browser: {}", html.display()));
                 }
                 return Some(JobEnd::Finished {
                     passed: verdict.as_ref().map(Verdict::passed),

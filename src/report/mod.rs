@@ -2,8 +2,13 @@
 //! which distance and compensation, every point with its deviation, the statistics and the verdicts. One folder
 //! per part holds report.json (everything), deviations.csv (one row per point) and summary.txt (for the operator).
 
+mod export;
+mod html;
+mod plots;
+mod qif;
 mod store;
 mod summary;
+mod trend;
 mod writers;
 
 use std::path::Path;
@@ -12,8 +17,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::geometry::fit3l::FitMethod;
+pub use export::history_csv;
+pub use html::{write_html, HTML_FILE};
+pub use qif::{write_qif, QIF_FILE};
 pub use store::{ProfileRecord, Store, StoreError, STORE_FILE};
 pub use summary::summary_text;
+pub use trend::{trend, trend_text, TrendRow};
 pub use writers::{write_report, DEVIATIONS_FILE, REPORT_FILE, SUMMARY_FILE};
 
 pub const FORMAT: &str = "zeroset-report";

@@ -92,6 +92,9 @@ pub struct ProfileRecord {
     pub min_mm: f64,
     pub max_mm: f64,
     pub passed: bool,
+    /// The inspection's tolerance band, mm.
+    pub lower_mm: f64,
+    pub upper_mm: f64,
 }
 
 impl Store {
@@ -168,7 +171,7 @@ impl Store {
             .connection
             .prepare(
                 "SELECT i.serial, i.finished, p.instance, p.profile, p.points, p.mean_mm, p.rms_mm, p.min_mm,
-                        p.max_mm, p.passed
+                        p.max_mm, p.passed, i.lower_mm, i.upper_mm
                  FROM profile_stats p JOIN inspections i ON i.id = p.inspection
                  WHERE i.id IN (SELECT id FROM inspections WHERE part_type = ?1
                                 ORDER BY finished DESC, id DESC LIMIT ?2)
@@ -188,6 +191,8 @@ impl Store {
                     min_mm: row.get(7)?,
                     max_mm: row.get(8)?,
                     passed: row.get(9)?,
+                    lower_mm: row.get(10)?,
+                    upper_mm: row.get(11)?,
                 })
             })
             .map_err(|e| self.error(e))?;

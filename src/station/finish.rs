@@ -17,8 +17,8 @@ use crate::analysis::surface_point;
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
 use crate::plan::Plan;
 use crate::report::{
-    write_report, InstanceReport, MachineUse, PartReport, PointRecord, ProfileReport, ReferenceUse,
-    Store,
+    write_html, write_qif, write_report, InstanceReport, MachineUse, PartReport, PointRecord,
+    ProfileReport, ReferenceUse, Store,
 };
 
 /// How a finished job ended.
@@ -223,6 +223,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         .join(plan.part())
         .join(&serial)
         .join(&inputs.record.id);
+    // The HTML and QIF reports first: report.json is written last, so a folder holding it is complete.
+    std::fs::create_dir_all(&folder)
+        .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
+    write_html(&folder, &report).map_err(|e| e.to_string())?;
+    write_qif(&folder, &report).map_err(|e| e.to_string())?;
     write_report(&folder, &report).map_err(|e| e.to_string())?;
     copy_scans(dir, &folder).map_err(|e| e.to_string())?;
     // Last: once the history holds the inspection, it is done (the daemon then closes its journal; a daemon killed

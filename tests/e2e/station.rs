@@ -75,6 +75,23 @@ fn worst_disagreements(profile: &zeroset::report::ProfileReport, truth: &[f64]) 
         .join("\n")
 }
 
+/// Validates a QIF document against the QIF 3.0 schema with xmllint, exactly as the issue states it.
+fn assert_qif_valid(file: &std::path::Path) {
+    let schema = crate::support::repo().join("../shared/reference/qif3/QIFDocument.xsd");
+    let out = std::process::Command::new("xmllint")
+        .args(["--noout", "--nonet", "--schema"])
+        .arg(&schema)
+        .arg(file)
+        .output()
+        .expect("xmllint runs (apt-get install -y libxml2-utils)");
+    assert!(
+        out.status.success(),
+        "{} does not validate:\n{}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Teaches the propeller, failing the test with what the CLI printed if it does not work.
 fn teach(station: &Station) {
     let out = station.cli_ok(&["teach", "propeller"]);
@@ -127,9 +144,40 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         );
     }
     let (dir, report) = station.report("SN-1");
-    for file in ["report.json", "deviations.csv", "summary.txt"] {
+    for file in [
+        "report.json",
+        "deviations.csv",
+        "summary.txt",
+        "report.html",
+        "report.qif",
+    ] {
         assert!(dir.join(file).is_file(), "{file} in {dir:?}");
     }
+    assert!(
+        out.contains(&format!(
+            "open in a browser: {}",
+            dir.join("report.html").display()
+        )),
+        "{out}"
+    );
+    assert_qif_valid(&dir.join("report.qif"));
+    // The same numbers in every report of the inspection.
+    let b300 = &report.instances[1].profiles[2];
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert_eq!(
+        html.matches("<svg").count(),
+        2 * 5,
+        "a deviation and a whisker plot per profile"
+    );
+    assert!(
+        html.contains(&format!("{:+.4}", b300.stats.mean_mm)),
+        "B r300's mean in the HTML"
+    );
+    let qif = std::fs::read_to_string(dir.join("report.qif")).unwrap();
+    for value in [b300.stats.max_mm, b300.stats.min_mm] {
+        assert!(qif.contains(&value.to_string()), "{value} in the QIF");
+    }
+    assert!(qif.contains("SN-1"), "the serial in the QIF");
     let truth = ground_truth(&report);
     let mut problems = Vec::new();
     for instance in &report.instances {
@@ -177,6 +225,21 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         summary.contains("mm") && summary.contains(&dir.display().to_string()),
         "{summary}"
     );
+    // The history holds the same numbers, and trends over them (one part: no spread yet, and a warning).
+    let trend = station.cli_ok(&["report", "--trend"]);
+    let b300 = &report.instances[1].profiles[2];
+    let row = trend
+        .lines()
+        .find(|l| l.starts_with("B ") && l.contains(" r300 "))
+        .unwrap_or_else(|| panic!("{trend}"));
+    assert!(
+        row.contains(&format!("{:+.4}", b300.stats.mean_mm)),
+        "{row} vs {:?}",
+        b300.stats
+    );
+    assert!(trend.contains("warning: 1 parts"), "{trend}");
+    let csv = station.cli_ok(&["report", "--export", "csv"]);
+    assert_eq!(csv.lines().count(), 1 + 15, "{csv}");
 }
 
 #[test]
@@ -352,6 +415,15 @@ fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
     let (_, report) = station.report("SN-4");
     assert_eq!(point_counts(&report), point_counts(&clean));
     assert_no_repeated_points(&report);
+    // The history holds both inspections once each, whole.
+    let csv = station.cli_ok(&["report", "--export", "csv"]);
+    for serial in ["SN-CLEAN", "SN-4"] {
+        let rows = csv
+            .lines()
+            .filter(|l| l.starts_with(&format!("{serial},")))
+            .count();
+        assert_eq!(rows, 15, "{serial}:\n{csv}");
+    }
 }
 
 #[test]

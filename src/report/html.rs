@@ -1,0 +1,281 @@
+//! report.html: the part's report for a quality engineer's browser. Self-contained (inline CSS and SVG, no
+//! scripts, nothing fetched), so that it can be mailed or archived as one file and still open years later.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use super::plots::{deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures};
+use super::{PartReport, ProfileReport};
+use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
+use crate::fsutil::write_atomically;
+
+pub const HTML_FILE: &str = "report.html";
+
+/// Deviations are shown to 0.1 um and coordinates to 1 um, as in summary.txt.
+const DEVIATION_DECIMALS: usize = 4;
+const COORDINATE_DECIMALS: usize = 3;
+
+const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;color:#222}\
+table{border-collapse:collapse;margin:0.5em 0 1.5em}\
+th,td{border:1px solid #bbb;padding:0.2em 0.6em;text-align:right}\
+th{background:#eee}td.name{text-align:left}\
+.verdict{font-size:2.5em;font-weight:bold;padding:0.1em 0.5em;display:inline-block}\
+.pass{color:#0a6b2d}.fail{color:#b00020}div.verdict.pass{background:#dff3e4}\
+div.verdict.fail{background:#fbe0e4}dl{display:grid;grid-template-columns:max-content auto;gap:0.2em 1em}\
+dt{font-weight:bold}dd{margin:0}figure{margin:1em 0}";
+
+/// Writes dir/report.html atomically. Errors name the file.
+pub fn write_html(dir: &Path, report: &PartReport) -> std::io::Result<()> {
+    let path = dir.join(HTML_FILE);
+    let html = report_html(report)
+        .map_err(|e| std::io::Error::other(format!("cannot write {}: {e}", path.display())))?;
+    write_atomically(&path, html.as_bytes())
+}
+
+/// The whole page.
+fn report_html(report: &PartReport) -> Result<String, PlotError> {
+    let title = escape(&format!(
+        "{} {}: inspection report",
+        report.part, report.serial
+    ));
+    let mut page = format!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n\
+         <style>{STYLE}</style>\n</head>\n<body>\n<h1>{title}</h1>\n"
+    );
+    page.push_str(&header_html(report));
+    page.push_str(&instance_table(report));
+    page.push_str(&profile_table(report));
+    page.push_str(&figures_html(report)?);
+    page.push_str("</body>\n</html>\n");
+    Ok(page)
+}
+
+/// The verdict, big, and what was measured when, with what, against what.
+fn header_html(report: &PartReport) -> String {
+    let class = verdict_class(&report.verdict);
+    let mut html = format!(
+        "<div class=\"verdict {class}\">{}</div>\n<dl>\n",
+        escape(&verdict_text(&report.verdict))
+    );
+    let machines: Vec<String> = report
+        .machines
+        .iter()
+        .map(|m| {
+            format!(
+                "{} (ball radius {:.COORDINATE_DECIMALS$} mm, {} profiles)",
+                m.name, m.ball_radius_mm, m.profiles_scanned
+            )
+        })
+        .collect();
+    let reference = &report.reference;
+    let rows = [
+        ("part", report.part.clone()),
+        ("serial", report.serial.clone()),
+        ("job", report.job.clone()),
+        ("started", report.started.clone()),
+        ("finished", report.finished.clone()),
+        ("machines", machines.join("; ")),
+        (
+            "reference",
+            format!(
+                "{} (taught {}; degree {}, {})",
+                reference.path,
+                reference.taught_at,
+                reference.degree,
+                reference.method.describe()
+            ),
+        ),
+        ("distance", report.distance.clone()),
+        ("compensation", report.compensation.clone()),
+        ("tolerance", tolerance_text(&report.tolerance)),
+        (
+            "units",
+            "all lengths in mm; deviations positive outside the material".to_string(),
+        ),
+    ];
+    for (label, value) in rows {
+        writeln!(html, "<dt>{label}</dt><dd>{}</dd>", escape(&value)).expect("writing to a String");
+    }
+    html.push_str("</dl>\n");
+    html
+}
+
+/// The columns after the names, as [`stats_row`] fills them.
+const STATS_COLUMNS: [&str; 9] = [
+    "points",
+    "mean",
+    "RMS",
+    "min",
+    "max",
+    "worst",
+    "worst at (x, y, z)",
+    "tolerance",
+    "verdict",
+];
+
+/// One row per instance, over all its profiles.
+fn instance_table(report: &PartReport) -> String {
+    let rows = report.instances.iter().map(|instance| {
+        let names = [instance.name.as_str()];
+        stats_row(
+            &names,
+            &instance.stats,
+            &report.tolerance,
+            &instance.verdict,
+        )
+    });
+    table("Instances", &["instance"], rows)
+}
+
+/// One row per instance and profile.
+fn profile_table(report: &PartReport) -> String {
+    let rows = report.instances.iter().flat_map(|instance| {
+        instance.profiles.iter().map(|profile: &ProfileReport| {
+            let names = [
+                instance.name.as_str(),
+                profile.name.as_str(),
+                profile.machine.as_str(),
+            ];
+            stats_row(&names, &profile.stats, &report.tolerance, &profile.verdict)
+        })
+    });
+    table("Profiles", &["instance", "profile", "machine"], rows)
+}
+
+fn table(heading: &str, names: &[&str], rows: impl Iterator<Item = String>) -> String {
+    let mut html = format!("<h2>{heading}</h2>\n<table>\n<tr>");
+    for column in names.iter().chain(&STATS_COLUMNS) {
+        write!(html, "<th>{column}</th>").expect("writing to a String");
+    }
+    html.push_str("</tr>\n");
+    rows.for_each(|row| html.push_str(&row));
+    html.push_str("</table>\n");
+    html
+}
+
+fn stats_row(
+    names: &[&str],
+    stats: &DeviationStats,
+    tolerance: &Tolerance,
+    verdict: &Verdict,
+) -> String {
+    let mut html = String::from("<tr>");
+    for name in names {
+        write!(html, "<td class=\"name\">{}</td>", escape(name)).expect("writing to a String");
+    }
+    let at = stats
+        .worst_at_mm
+        .map(|c| format!("{c:.COORDINATE_DECIMALS$}"));
+    let cells = [
+        stats.points.to_string(),
+        deviation_mm(stats.mean_mm),
+        format!("{:.DEVIATION_DECIMALS$} mm", stats.rms_mm),
+        deviation_mm(stats.min_mm),
+        deviation_mm(stats.max_mm),
+        deviation_mm(stats.worst_mm),
+        format!("({}) mm", at.join(", ")),
+        tolerance_text(tolerance),
+    ];
+    for cell in cells {
+        write!(html, "<td>{cell}</td>").expect("writing to a String");
+    }
+    writeln!(
+        html,
+        "<td class=\"name {}\">{}</td></tr>",
+        verdict_class(verdict),
+        verdict_cell(verdict)
+    )
+    .expect("writing to a String");
+    html
+}
+
+/// Per profile, the deviation figure then the whisker figure, with the instances that could not be drawn.
+fn figures_html(report: &PartReport) -> Result<String, PlotError> {
+    let mut html = String::from("<h2>Profiles: deviations</h2>\n");
+    for figures in profile_figures(report) {
+        html.push_str(&profile_figures_html(&figures, &report.tolerance)?);
+    }
+    Ok(html)
+}
+
+fn profile_figures_html(
+    figures: &ProfileFigures,
+    tolerance: &Tolerance,
+) -> Result<String, PlotError> {
+    let mut html = format!("<h3>Profile {}</h3>\n", escape(figures.name));
+    if !figures.unplotted.is_empty() {
+        writeln!(
+            html,
+            "<p>Not drawn (fewer than 3 points, or all on one line): {}</p>",
+            escape(&figures.unplotted.join(", "))
+        )
+        .expect("writing to a String");
+    }
+    for svg in [
+        deviation_svg(figures.name, &figures.sections, tolerance)?,
+        whisker_svg(figures.name, &figures.sections)?,
+    ] {
+        writeln!(html, "<figure>\n{svg}\n</figure>").expect("writing to a String");
+    }
+    Ok(html)
+}
+
+/// A signed deviation as the tables show it, e.g. "+0.0123 mm".
+fn deviation_mm(mm: f64) -> String {
+    format!("{mm:+.DEVIATION_DECIMALS$} mm")
+}
+
+fn tolerance_text(tolerance: &Tolerance) -> String {
+    format!(
+        "{} .. {}",
+        deviation_mm(tolerance.lower_mm),
+        deviation_mm(tolerance.upper_mm)
+    )
+}
+
+fn verdict_text(verdict: &Verdict) -> String {
+    match verdict {
+        Verdict::Pass => "PASS".to_string(),
+        Verdict::Fail {
+            points_outside,
+            worst_mm,
+        } => format!(
+            "FAIL: {points_outside} points outside the tolerance, worst {}",
+            deviation_mm(*worst_mm)
+        ),
+    }
+}
+
+/// The table's verdict: the worst deviation has its own column.
+fn verdict_cell(verdict: &Verdict) -> String {
+    match verdict {
+        Verdict::Pass => "PASS".to_string(),
+        Verdict::Fail { points_outside, .. } => format!("FAIL ({points_outside} outside)"),
+    }
+}
+
+fn verdict_class(verdict: &Verdict) -> &'static str {
+    match verdict {
+        Verdict::Pass => "pass",
+        Verdict::Fail { .. } => "fail",
+    }
+}
+
+/// Text made safe inside HTML elements and attribute values (names and paths come from configuration).
+fn escape(text: &str) -> String {
+    let mut escaped = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => escaped.push_str("&amp;"),
+            '<' => escaped.push_str("&lt;"),
+            '>' => escaped.push_str("&gt;"),
+            '"' => escaped.push_str("&quot;"),
+            '\'' => escaped.push_str("&#39;"),
+            _ => escaped.push(c),
+        }
+    }
+    escaped
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,289 @@
+use quick_xml::events::Event;
+
+use super::*;
+use crate::analysis::stats::RunningStats;
+use crate::geometry::fit3l::FitMethod;
+use crate::report::{
+    InstanceReport, MachineUse, PointRecord, ReferenceUse, FORMAT, UNITS, VERSION,
+};
+
+const TOLERANCE: Tolerance = Tolerance {
+    lower_mm: -0.1,
+    upper_mm: 0.1,
+};
+const PROFILES: [(&str, f64); 3] = [("r100", 100.0), ("r300", 300.0), ("r500", 500.0)];
+
+/// A blade section at `radius` from the z axis in the vertical plane at `azimuth_deg`: an ellipse of half-axes
+/// 40 and 5 mm, lifted by `lift_mm` along z, whose deviations are the lift seen along each normal (a blade lying
+/// above the model reads positive on its upper face and negative on its lower one, as in seed 003).
+fn section(radius: f64, azimuth_deg: f64, lift_mm: f64) -> Vec<PointRecord> {
+    let (sin_a, cos_a) = azimuth_deg.to_radians().sin_cos();
+    (0..60)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / 60.0;
+            let (along, up) = (40.0 * t.cos(), 5.0 * t.sin() + lift_mm);
+            let surface = [
+                radius * cos_a - along * sin_a,
+                radius * sin_a + along * cos_a,
+                up,
+            ];
+            let (n_along, n_up) = (5.0 * t.cos(), 40.0 * t.sin());
+            let length = n_along.hypot(n_up);
+            let normal = [
+                -n_along * sin_a / length,
+                n_along * cos_a / length,
+                n_up / length,
+            ];
+            PointRecord {
+                centre: [
+                    surface[0] + normal[0],
+                    surface[1] + normal[1],
+                    surface[2] + normal[2],
+                ],
+                normal,
+                surface,
+                deviation_mm: lift_mm * normal[2],
+                off_plane_mm: 0.0,
+                quality: 1.0,
+            }
+        })
+        .collect()
+}
+
+fn verdict_of(stats: &RunningStats, points: &[PointRecord]) -> (DeviationStats, Verdict) {
+    let summary = stats.summary().unwrap();
+    let outside = points
+        .iter()
+        .filter(|p| !TOLERANCE.contains(p.deviation_mm))
+        .count();
+    (summary, TOLERANCE.verdict(&summary, outside))
+}
+
+fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceReport {
+    let mut all = RunningStats::default();
+    let mut all_points = Vec::new();
+    let profiles = PROFILES
+        .iter()
+        .map(|&(profile, radius)| {
+            let points = section(radius, azimuth_deg, lift_per_100_mm * radius / 100.0);
+            let mut stats = RunningStats::default();
+            points
+                .iter()
+                .for_each(|p| stats.push(p.deviation_mm, p.surface));
+            all.merge(&stats);
+            all_points.extend_from_slice(&points);
+            let (stats, verdict) = verdict_of(&stats, &points);
+            ProfileReport {
+                name: profile.to_string(),
+                x_mm: radius,
+                machine: "cmm1".to_string(),
+                scanned_at: "2025-03-04T10:11:12Z".to_string(),
+                stats,
+                verdict,
+                points,
+            }
+        })
+        .collect();
+    let (stats, verdict) = verdict_of(&all, &all_points);
+    InstanceReport {
+        name: name.to_string(),
+        stats,
+        verdict,
+        profiles,
+    }
+}
+
+/// Blades A (the model), B below it and C above it, sinking and rising further outwards as in seed 003.
+fn propeller(instances: Vec<InstanceReport>) -> PartReport {
+    let failing = instances
+        .iter()
+        .filter_map(|i| match i.verdict {
+            Verdict::Fail { points_outside, .. } => Some(points_outside),
+            Verdict::Pass => None,
+        })
+        .sum();
+    let worst = instances
+        .iter()
+        .map(|i| i.stats.worst_mm)
+        .fold(0.0, |w: f64, d| if d.abs() > w.abs() { d } else { w });
+    PartReport {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        units: UNITS.to_string(),
+        part: "propeller".to_string(),
+        serial: "SN-7".to_string(),
+        job: "job-7".to_string(),
+        started: "2025-03-04T10:00:00Z".to_string(),
+        finished: "2025-03-04T10:20:00Z".to_string(),
+        machines: vec![MachineUse {
+            name: "cmm1".to_string(),
+            ball_radius_mm: 1.0,
+            profiles_scanned: instances.len() * PROFILES.len(),
+        }],
+        reference: ReferenceUse {
+            path: "data/references/propeller.json".to_string(),
+            taught_at: "2025-03-01T08:00:00Z".to_string(),
+            method: FitMethod::ThreeL,
+            degree: 4,
+        },
+        distance: "exact orthogonal distance".to_string(),
+        compensation: "ball radius along the normal".to_string(),
+        tolerance: TOLERANCE,
+        verdict: if failing == 0 {
+            Verdict::Pass
+        } else {
+            Verdict::Fail {
+                points_outside: failing,
+                worst_mm: worst,
+            }
+        },
+        instances,
+    }
+}
+
+fn three_blades() -> PartReport {
+    propeller(vec![
+        instance("A", 0.0, 0.0),
+        instance("B", 120.0, -0.2),
+        instance("C", 240.0, 0.2),
+    ])
+}
+
+/// How plotters writes a text element holding `text`.
+fn svg_text(text: &str) -> String {
+    format!(">\n{text}\n</text>")
+}
+
+/// The inline SVG documents of a page, in order.
+fn svgs(html: &str) -> Vec<&str> {
+    html.match_indices("<svg")
+        .map(|(start, _)| {
+            let end = html[start..].find("</svg>").expect("an <svg> is closed") + start;
+            &html[start..end + "</svg>".len()]
+        })
+        .collect()
+}
+
+/// Fails unless `document` is well-formed XML (every element closed, in order, by its own name).
+fn assert_well_formed(document: &str) {
+    let mut reader = quick_xml::Reader::from_str(document);
+    let mut depth = 0usize;
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(_)) => depth += 1,
+            Ok(Event::End(_)) => depth -= 1,
+            Ok(Event::Eof) => break,
+            Ok(_) => {}
+            Err(e) => panic!("not well-formed at {}: {e}", reader.buffer_position()),
+        }
+    }
+    assert_eq!(depth, 0, "unclosed elements");
+}
+
+#[test]
+fn every_profile_has_a_deviation_and_a_whisker_plot_with_units() {
+    let html = report_html(&three_blades()).unwrap();
+    assert_eq!(html.matches("<svg").count(), 2 * PROFILES.len());
+    assert_eq!(html.matches("</svg>").count(), 2 * PROFILES.len());
+    let plots = svgs(&html);
+    for (k, (profile, _)) in PROFILES.iter().enumerate() {
+        let (deviation, whiskers) = (plots[2 * k], plots[2 * k + 1]);
+        assert_well_formed(deviation);
+        assert_well_formed(whiskers);
+        assert!(
+            deviation.contains(&format!("{profile}: signed deviation")),
+            "{profile}"
+        );
+        assert!(deviation.contains("deviation (mm)"), "{profile}");
+        assert!(
+            deviation.contains("tolerance -0.100 .. +0.100 mm"),
+            "{profile}"
+        );
+        assert!(whiskers.contains("u, horizontal (mm)"), "{profile}");
+        for name in ["A", "B", "C"] {
+            assert!(
+                deviation.contains(&svg_text(name)),
+                "{profile}: legend {name}"
+            );
+            assert!(
+                whiskers.contains(&svg_text(name)),
+                "{profile}: panel {name}"
+            );
+        }
+    }
+    // The largest deviation, 1.0 mm on r500, against a 80 mm chord: 0.1 * 80 / 1.0 = 8, drawn x 10.
+    assert!(plots[5].contains("whiskers x 10 "), "r500 magnification");
+    // r100 reaches 0.2 mm: 40, drawn x 50.
+    assert!(plots[1].contains("whiskers x 50 "), "r100 magnification");
+}
+
+#[test]
+fn the_page_states_the_verdict_and_every_profile_mean_as_tabled() {
+    let report = three_blades();
+    let html = report_html(&report).unwrap();
+    assert!(html.contains("<div class=\"verdict fail\">FAIL: "));
+    assert!(html.contains("ball radius 1.000 mm"));
+    assert!(html.contains("<dd>-0.1000 mm .. +0.1000 mm</dd>"));
+    for instance in &report.instances {
+        assert!(html.contains(&format!("<td class=\"name\">{}</td>", instance.name)));
+        for profile in &instance.profiles {
+            let mean = deviation_mm(profile.stats.mean_mm);
+            assert!(
+                html.contains(&format!("<td>{mean}</td>")),
+                "{} {}",
+                instance.name,
+                profile.name
+            );
+        }
+    }
+    // B's upper faces lie 0.2 mm per 100 mm of radius below A's: r500's worst is -1.0 mm at its top, z = 4.
+    let r500 = &report.instances[1].profiles[2];
+    assert_eq!(deviation_mm(r500.stats.worst_mm), "-1.0000 mm");
+    assert!(html.contains("<td>-1.0000 mm</td>"));
+    let passing = report_html(&propeller(vec![instance("A", 0.0, 0.0)])).unwrap();
+    assert!(passing.contains("<div class=\"verdict pass\">PASS</div>"));
+    assert!(!passing.contains("FAIL"));
+}
+
+#[test]
+fn names_from_configuration_are_escaped() {
+    let mut report = propeller(vec![instance("A&<B>", 0.0, 0.0)]);
+    report.serial = "SN\"1'".to_string();
+    let html = report_html(&report).unwrap();
+    assert!(html.contains("A&amp;&lt;B&gt;"));
+    assert!(html.contains("SN&quot;1&#39;"));
+    assert!(!html.contains("A&<B>"));
+    svgs(&html).into_iter().for_each(assert_well_formed);
+}
+
+#[test]
+fn an_instance_without_a_plane_is_named_and_left_out_of_the_figures() {
+    let mut report = three_blades();
+    report.instances[2].profiles[0].points.truncate(2);
+    let html = report_html(&report).unwrap();
+    assert!(html.contains("Not drawn (fewer than 3 points, or all on one line): C</p>"));
+    assert_eq!(html.matches("<svg").count(), 2 * PROFILES.len());
+    let r100 = svgs(&html)[0];
+    assert!(!r100.contains(&svg_text("C")) && r100.contains(&svg_text("B")));
+}
+
+#[test]
+fn write_html_replaces_the_file_and_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join(HTML_FILE), "old").unwrap();
+    let report = three_blades();
+    write_html(dir.path(), &report).unwrap();
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(names, [HTML_FILE]);
+    let written = std::fs::read_to_string(dir.path().join(HTML_FILE)).unwrap();
+    assert_eq!(written, report_html(&report).unwrap());
+    let missing = dir.path().join("no-such-folder");
+    let error = write_html(&missing, &report).unwrap_err().to_string();
+    assert!(
+        error.contains("no-such-folder") && error.contains(HTML_FILE),
+        "{error}"
+    );
+}
