@@ -286,7 +286,7 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
 
 /// `--trend` and `--export`: read from the history's database directly (no daemon needed).
 fn history(args: &ReportArgs) -> anyhow::Result<()> {
-    use crate::report::{history_csv, trend, trend_text, Store, STORE_FILE};
+    use crate::report::{history_csv, trend, trend_text, write_trend_html, Store, STORE_FILE};
     let config = StationConfig::load(&args.station.config)?;
     let store = Store::open(&config.folders.data.join(STORE_FILE))?;
     let history = store.profile_history(&args.part_type, args.last)?;
@@ -308,9 +308,12 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
         .collect::<std::collections::BTreeSet<_>>()
         .len();
     println!("{} trend: the last {parts} inspections", args.part_type);
-    print!(
-        "{}",
-        trend_text(&trend(&history, lower, upper), lower, upper)
-    );
+    let rows = trend(&history, lower, upper);
+    print!("{}", trend_text(&rows, lower, upper));
+    let folder = config.folders.reports.join(&args.part_type);
+    std::fs::create_dir_all(&folder)
+        .with_context(|| format!("cannot create {}", folder.display()))?;
+    let chart = write_trend_html(&folder, &args.part_type, &rows, lower, upper)?;
+    println!("run charts: {}", chart.display());
     Ok(())
 }

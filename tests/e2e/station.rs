@@ -92,6 +92,51 @@ fn assert_qif_valid(file: &std::path::Path) {
     );
 }
 
+/// Renders a report page with headless Chromium to PNG, and checks that the browser's page has two plots (the
+/// deviations and the whiskers) per profile. Skipped, saying so, where Chromium is not installed.
+fn render_in_a_browser(page: &std::path::Path, profiles: usize) {
+    let Ok(browser) = which("chromium") else {
+        eprintln!("skipped: chromium is not installed (.ci/run installs Debian's chromium)");
+        return;
+    };
+    let url = format!("file://{}", page.display());
+    let png = page.with_extension("png");
+    let headless = ["--headless", "--no-sandbox", "--disable-gpu"];
+    let shot = std::process::Command::new(&browser)
+        .args(headless)
+        .arg(format!("--screenshot={}", png.display()))
+        .args(["--window-size=1280,3000", &url])
+        .output()
+        .expect("chromium runs");
+    assert!(
+        shot.status.success(),
+        "{}",
+        String::from_utf8_lossy(&shot.stderr)
+    );
+    assert!(std::fs::metadata(&png).expect("a screenshot").len() > 10_000);
+    let dom = std::process::Command::new(&browser)
+        .args(headless)
+        .args(["--dump-dom", &url])
+        .output()
+        .expect("chromium runs");
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert_eq!(
+        dom.matches("<svg").count(),
+        2 * profiles,
+        "plots in the rendered page"
+    );
+}
+
+/// The path of an installed program.
+fn which(program: &str) -> Result<std::path::PathBuf, ()> {
+    std::env::var_os("PATH")
+        .iter()
+        .flat_map(std::env::split_paths)
+        .map(|dir| dir.join(program))
+        .find(|path| path.is_file())
+        .ok_or(())
+}
+
 /// Teaches the propeller, failing the test with what the CLI printed if it does not work.
 fn teach(station: &Station) {
     let out = station.cli_ok(&["teach", "propeller"]);
@@ -161,6 +206,7 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         "{out}"
     );
     assert_qif_valid(&dir.join("report.qif"));
+    render_in_a_browser(&dir.join("report.html"), 5);
     // The same numbers in every report of the inspection.
     let b300 = &report.instances[1].profiles[2];
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
@@ -238,6 +284,16 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         b300.stats
     );
     assert!(trend.contains("warning: 1 parts"), "{trend}");
+    let chart = trend
+        .lines()
+        .find_map(|l| l.strip_prefix("run charts: "))
+        .unwrap_or_else(|| panic!("{trend}"));
+    let chart = std::fs::read_to_string(chart).expect("trend.html");
+    assert_eq!(
+        chart.matches("<svg").count(),
+        15,
+        "a run chart per profile of each blade"
+    );
     let csv = station.cli_ok(&["report", "--export", "csv"]);
     assert_eq!(csv.lines().count(), 1 + 15, "{csv}");
 }
