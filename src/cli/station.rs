@@ -278,6 +278,13 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
         Reply::Report { dir, summary } => {
             println!("{summary}");
             println!("report folder: {}", dir.display());
+            for file in [
+                crate::report::HTML_FILE,
+                crate::report::QIF_FILE,
+                crate::report::REPORT_FILE,
+            ] {
+                println!("  {}", dir.join(file).display());
+            }
             Ok(())
         }
         other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),

@@ -268,6 +268,10 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     assert!(!report.instances[1].verdict.passed(), "blade B fails");
     let summary = station.cli_ok(&["report", "SN-1"]);
     assert!(
+        summary.contains(&dir.join("report.qif").display().to_string()),
+        "{summary}"
+    );
+    assert!(
         summary.contains("mm") && summary.contains(&dir.display().to_string()),
         "{summary}"
     );
