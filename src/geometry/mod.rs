@@ -11,4 +11,5 @@ pub mod poly;
 pub mod published;
 pub mod sampling;
 pub mod small;
+pub mod supershape;
 pub mod trace;
