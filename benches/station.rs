@@ -55,20 +55,10 @@ fn start(sim_config: &str) -> Station {
         .stdout(Stdio::piped())
         .spawn()
         .expect("the simulator starts");
-    let mut out = BufReader::new(sim.stdout.take().unwrap());
-    let expected =
-        zeroset_sim::config::SimConfig::load(&repo().join("config/sims").join(sim_config))
-            .unwrap()
-            .machines
-            .len();
-    let mut machines = Vec::new();
-    while machines.len() < expected {
-        let mut line = String::new();
-        out.read_line(&mut line).unwrap();
-        if let Some((name, _)) = zeroset_sim::simulator::parse_announcement(&line) {
-            machines.push(name);
-        }
-    }
+    let out = BufReader::new(sim.stdout.take().unwrap());
+    let machines =
+        zeroset::cli::demo::read_announcements(out, &repo().join("config/sims").join(sim_config))
+            .expect("the simulator announces its machines");
     let text = zeroset::cli::demo::station_for_simulator(
         &repo().join("config/station.toml"),
         &machines,
@@ -85,12 +75,7 @@ fn start(sim_config: &str) -> Station {
         .stderr(Stdio::null())
         .spawn()
         .expect("the daemon starts");
-    let socket = root.join("zeroset.sock");
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while UnixStream::connect(&socket).is_err() {
-        assert!(Instant::now() < deadline, "no daemon socket");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    zeroset::cli::demo::wait_for_socket(&root.join("zeroset.sock")).expect("the daemon serves");
     Station {
         root,
         station,

@@ -126,8 +126,9 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The simulator's `machine NAME PATH` lines, one per configured machine.
-fn read_announcements(
+/// The simulator's `machine NAME PATH` lines, one per configured machine (the demo, the tests and the bench
+/// start it alike).
+pub fn read_announcements(
     mut out: BufReader<std::process::ChildStdout>,
     config: &Path,
 ) -> anyhow::Result<Vec<String>> {
@@ -207,8 +208,12 @@ fn path_value(path: &Path) -> toml::Value {
     path.display().to_string().into()
 }
 
-fn wait_for_socket(socket: &Path) -> anyhow::Result<()> {
-    let deadline = Instant::now() + Duration::from_secs(20);
+/// How long a daemon may take to open its control socket: headroom for a loaded CI machine.
+const DAEMON_START: Duration = Duration::from_secs(30);
+
+/// Waits until a daemon answers on its control socket.
+pub fn wait_for_socket(socket: &Path) -> anyhow::Result<()> {
+    let deadline = Instant::now() + DAEMON_START;
     while Instant::now() < deadline {
         if std::os::unix::net::UnixStream::connect(socket).is_ok() {
             return Ok(());
@@ -216,7 +221,8 @@ fn wait_for_socket(socket: &Path) -> anyhow::Result<()> {
         std::thread::sleep(Duration::from_millis(50));
     }
     anyhow::bail!(
-        "the daemon did not open {} within 20 s; see daemon.stderr beside it",
-        socket.display()
+        "the daemon did not open {} within {} s; see its standard error",
+        socket.display(),
+        DAEMON_START.as_secs()
     )
 }

@@ -5,15 +5,12 @@ use std::fmt::Write;
 use std::path::Path;
 
 use super::plots::{deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures};
+use super::summary::{deviation, machine_text, COORDINATE_DECIMALS, DEVIATION_DECIMALS};
 use super::{PartReport, ProfileReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::fsutil::write_atomically;
 
 pub const HTML_FILE: &str = "report.html";
-
-/// Deviations are shown to 0.1 um and coordinates to 1 um, as in summary.txt.
-const DEVIATION_DECIMALS: usize = 4;
-const COORDINATE_DECIMALS: usize = 3;
 
 const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;color:#222}\
 table{border-collapse:collapse;margin:0.5em 0 1.5em}\
@@ -57,16 +54,7 @@ fn header_html(report: &PartReport) -> String {
         "<div class=\"verdict {class}\">{}</div>\n<dl>\n",
         escape(&verdict_text(&report.verdict))
     );
-    let machines: Vec<String> = report
-        .machines
-        .iter()
-        .map(|m| {
-            format!(
-                "{} (ball radius {:.COORDINATE_DECIMALS$} mm, {} profiles)",
-                m.name, m.ball_radius_mm, m.profiles_scanned
-            )
-        })
-        .collect();
+    let machines: Vec<String> = report.machines.iter().map(machine_text).collect();
     let reference = &report.reference;
     let rows = [
         ("part", report.part.clone()),
@@ -222,7 +210,7 @@ fn profile_figures_html(
 
 /// A signed deviation as the tables show it, e.g. "+0.0123 mm".
 fn deviation_mm(mm: f64) -> String {
-    format!("{mm:+.DEVIATION_DECIMALS$} mm")
+    format!("{} mm", deviation(mm))
 }
 
 fn tolerance_text(tolerance: &Tolerance) -> String {
@@ -262,7 +250,7 @@ fn verdict_class(verdict: &Verdict) -> &'static str {
 }
 
 /// Text made safe inside HTML elements and attribute values (names and paths come from configuration).
-fn escape(text: &str) -> String {
+pub(super) fn escape(text: &str) -> String {
     let mut escaped = String::with_capacity(text.len());
     for c in text.chars() {
         match c {

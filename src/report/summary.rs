@@ -6,9 +6,9 @@ use std::fmt::Write;
 use super::PartReport;
 use crate::analysis::stats::{DeviationStats, Verdict};
 
-/// Deviations are shown to 0.1 um, coordinates to 1 um.
-const DEVIATION_DECIMALS: usize = 4;
-const COORDINATE_DECIMALS: usize = 3;
+/// Deviations are shown to 0.1 um, coordinates to 1 um, in every report people read.
+pub(super) const DEVIATION_DECIMALS: usize = 4;
+pub(super) const COORDINATE_DECIMALS: usize = 3;
 
 const COLUMNS: [&str; 11] = [
     "instance",
@@ -29,16 +29,7 @@ const LEFT_ALIGNED: [usize; 3] = [0, 1, 10];
 /// The summary table as text (also printed by the CLI).
 pub fn summary_text(report: &PartReport) -> String {
     let mut text = String::new();
-    let machines: Vec<String> = report
-        .machines
-        .iter()
-        .map(|m| {
-            format!(
-                "{} (ball radius {:.COORDINATE_DECIMALS$} mm, {} profiles)",
-                m.name, m.ball_radius_mm, m.profiles_scanned
-            )
-        })
-        .collect();
+    let machines: Vec<String> = report.machines.iter().map(machine_text).collect();
     let reference = &report.reference;
     let lines = [
         (
@@ -138,7 +129,16 @@ fn row(
     ]
 }
 
-fn deviation(mm: f64) -> String {
+/// A machine as the reports name it: its name, its ball and how many profiles it scanned.
+pub(super) fn machine_text(m: &super::MachineUse) -> String {
+    format!(
+        "{} (ball radius {:.COORDINATE_DECIMALS$} mm, {} profiles)",
+        m.name, m.ball_radius_mm, m.profiles_scanned
+    )
+}
+
+/// A signed deviation as every report shows it, e.g. "+0.0123" (in mm).
+pub(super) fn deviation(mm: f64) -> String {
     format!("{mm:+.DEVIATION_DECIMALS$}")
 }
 

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use super::html::escape;
 use super::trend::{trend_text, TrendRow};
 use crate::fsutil::write_atomically;
 
@@ -101,12 +102,6 @@ fn run_chart(row: &TrendRow, lower_mm: f64, upper_mm: f64) -> Result<String, Str
         root.present().map_err(failed)?;
     }
     Ok(svg)
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
 }
 
 #[cfg(test)]

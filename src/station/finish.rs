@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 
 use super::job::job_scans;
 use super::journal::{file_stem, JobDir, JobRecord};
-use super::pipeline::{in_part_frame, scan_ref};
+use super::pipeline::scan_ref;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::{teach, MasterProfile, Reference, ReferenceSettings};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
@@ -48,7 +48,7 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
             .iter()
             .map(|raw| {
                 (
-                    in_part_frame(plan, key, raw, scan.header.ball_radius_mm),
+                    to_part * surface_point(raw, scan.header.ball_radius_mm),
                     to_part * Vector3::from(raw.normal).normalize(),
                 )
             })
@@ -138,24 +138,23 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     profiles_scanned: 0,
                 })
                 .profiles_scanned += 1;
+            let to_part = plan.instance_to_machine(key.instance).inverse();
             let mut gauge = inputs.gauges[key.profile].scan();
             let mut stats = RunningStats::default();
             let mut profile_outside = 0;
             let mut points = Vec::with_capacity(scan.points.len());
             for raw in &scan.points {
                 let surface = surface_point(raw, radius);
-                let measured = gauge
-                    .measure(&in_part_frame(plan, key, raw, radius))
-                    .map_err(|e| {
-                        format!(
-                            "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
-                            plan.describe(key),
-                            file_stem(&scan_name),
-                            surface.x,
-                            surface.y,
-                            surface.z
-                        )
-                    })?;
+                let measured = gauge.measure(&(to_part * surface)).map_err(|e| {
+                    format!(
+                        "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
+                        plan.describe(key),
+                        file_stem(&scan_name),
+                        surface.x,
+                        surface.y,
+                        surface.z
+                    )
+                })?;
                 stats.push(measured.deviation_mm, surface.coords.into());
                 if !inputs.tolerance.contains(measured.deviation_mm) {
                     profile_outside += 1;

@@ -301,19 +301,27 @@ mod tests {
         }
     }
 
+    fn header() -> ScanHeader {
+        ScanHeader {
+            machine: "cmm1".into(),
+            ball_radius_mm: 1.0,
+            started: "t".into(),
+        }
+    }
+
+    fn scan_ref(instance: &str, profile: &str) -> ScanRef {
+        ScanRef {
+            instance: instance.into(),
+            profile: profile.into(),
+        }
+    }
+
     #[test]
     fn a_profile_counts_as_done_only_once_its_scan_file_is_written() {
         let data = tempfile::tempdir().unwrap();
         let dir = JobDir::create(data.path(), &record()).unwrap();
-        let scan = ScanRef {
-            instance: "B".into(),
-            profile: "r300".into(),
-        };
-        let header = ScanHeader {
-            machine: "cmm1".into(),
-            ball_radius_mm: 1.0,
-            started: "t".into(),
-        };
+        let scan = scan_ref("B", "r300");
+        let header = header();
         let mut partial = dir.start_partial(&scan, &header).unwrap();
         partial.push(&point(1.0)).unwrap();
         partial.push(&point(2.0)).unwrap();
@@ -353,15 +361,8 @@ mod tests {
     fn a_line_cut_by_a_kill_is_dropped_and_the_rest_kept() {
         let data = tempfile::tempdir().unwrap();
         let dir = JobDir::create(data.path(), &record()).unwrap();
-        let scan = ScanRef {
-            instance: "A".into(),
-            profile: "r100".into(),
-        };
-        let header = ScanHeader {
-            machine: "cmm1".into(),
-            ball_radius_mm: 1.0,
-            started: "t".into(),
-        };
+        let scan = scan_ref("A", "r100");
+        let header = header();
         let mut partial = dir.start_partial(&scan, &header).unwrap();
         partial.push(&point(1.0)).unwrap();
         partial.file.write_all(b"{\"centre\":[1.0,").unwrap();

@@ -199,13 +199,3 @@ pub fn scan_ref(plan: &Plan, key: ProfileKey) -> ScanRef {
         profile: plan.profile_names()[key.profile].to_string(),
     }
 }
-
-/// The surface point of a raw point in the master's part frame.
-pub fn in_part_frame(
-    plan: &Plan,
-    key: ProfileKey,
-    raw: &RawPoint,
-    ball_radius_mm: f64,
-) -> Point3<f64> {
-    plan.instance_to_machine(key.instance).inverse() * surface_point(raw, ball_radius_mm)
-}

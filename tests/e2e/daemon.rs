@@ -64,15 +64,7 @@ impl Station {
             .spawn()
             .expect("the daemon starts");
         self.daemon = Some(child);
-        let socket = self.socket();
-        let deadline = Instant::now() + Duration::from_secs(30);
-        while std::os::unix::net::UnixStream::connect(&socket).is_err() {
-            assert!(
-                Instant::now() < deadline,
-                "the daemon did not open {socket:?}"
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
+        zeroset::cli::demo::wait_for_socket(&self.socket()).expect("the daemon starts serving");
     }
 
     /// Gives this station the propeller's reference, taught once for all the tests that only inspect (teaching
