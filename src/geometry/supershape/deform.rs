@@ -3,7 +3,7 @@
 //! F(P) = F_can(D^-1(P)) (seed 000 eq. 9): the inverse brings a point of the model frame back into the
 //! primitive's canonical frame.
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// One global deformation, acting on the canonical frame whose z axis is the primitive's axis.
@@ -69,6 +69,68 @@ impl Deformation {
             Deformation::Rigid(iso) => iso.inverse_transform_point(p),
         }
     }
+
+    /// The Jacobian of D^-1 at `p` (rows: canonical coordinates, columns: deformed ones), for the
+    /// chain rule grad F(P) = J^T grad F_can(D^-1(P)).
+    pub fn inverse_jacobian(&self, p: &Point3<f64>) -> Matrix3<f64> {
+        match *self {
+            Deformation::Scale(s) => {
+                Matrix3::from_diagonal(&Vector3::new(1.0 / s[0], 1.0 / s[1], 1.0 / s[2]))
+            }
+            Deformation::Taper { kx, ky } => {
+                let (fx, fy) = (1.0 + kx * p.z, 1.0 + ky * p.z);
+                Matrix3::new(
+                    1.0 / fx,
+                    0.0,
+                    -p.x * kx / (fx * fx),
+                    0.0,
+                    1.0 / fy,
+                    -p.y * ky / (fy * fy),
+                    0.0,
+                    0.0,
+                    1.0,
+                )
+            }
+            Deformation::Twist { rate } => {
+                let (sin, cos) = (-rate * p.z).sin_cos();
+                // x' = cos a x - sin a y, y' = sin a x + cos a y with a = -rate z.
+                Matrix3::new(
+                    cos,
+                    -sin,
+                    (-sin * p.x - cos * p.y) * -rate,
+                    sin,
+                    cos,
+                    (cos * p.x - sin * p.y) * -rate,
+                    0.0,
+                    0.0,
+                    1.0,
+                )
+            }
+            Deformation::Bend { curvature } => {
+                if curvature == 0.0 {
+                    return Matrix3::identity();
+                }
+                let radius = 1.0 / curvature;
+                let sign = curvature.signum();
+                let (along, across) = (radius - p.x, p.z);
+                let h2 = along * along + across * across;
+                let h = h2.sqrt();
+                // x' = R - sign h, z' = atan2(sign across, sign along) / curvature.
+                Matrix3::new(
+                    sign * along / h,
+                    0.0,
+                    -sign * across / h,
+                    0.0,
+                    1.0,
+                    0.0,
+                    across / (h2 * curvature),
+                    0.0,
+                    along / (h2 * curvature),
+                )
+            }
+            Deformation::Rigid(iso) => iso.rotation.inverse().to_rotation_matrix().into_inner(),
+        }
+    }
 }
 
 /// A chain of deformations applied in order: D = D_n o ... o D_1, so D^-1 undoes them from the last.
@@ -86,6 +148,16 @@ impl Deformations {
     pub fn inverse(&self, p: &Point3<f64>) -> Point3<f64> {
         self.0.iter().rev().fold(*p, |q, d| d.inverse(&q))
     }
+
+    /// D^-1(P) and its Jacobian, by the chain rule through the chain from the last deformation.
+    pub fn inverse_with_jacobian(&self, p: &Point3<f64>) -> (Point3<f64>, Matrix3<f64>) {
+        self.0
+            .iter()
+            .rev()
+            .fold((*p, Matrix3::identity()), |(q, jacobian), d| {
+                (d.inverse(&q), d.inverse_jacobian(&q) * jacobian)
+            })
+    }
 }
 
 fn rotate_about_z(p: &Point3<f64>, angle: f64) -> Point3<f64> {
@@ -96,7 +168,7 @@ fn rotate_about_z(p: &Point3<f64>, angle: f64) -> Point3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Translation3, UnitQuaternion, Vector3};
+    use nalgebra::{Translation3, UnitQuaternion};
 
     fn rigid() -> Deformation {
         Deformation::Rigid(Isometry3::from_parts(
@@ -149,6 +221,26 @@ mod tests {
         for p in points() {
             assert!((chain.inverse(&chain.apply(&p)) - p).norm() < 1e-12);
             assert!((chain.apply(&chain.inverse(&p)) - p).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn inverse_jacobians_match_finite_differences() {
+        let chain = Deformations(deformations());
+        let h = 1e-6;
+        for p in points() {
+            let p = chain.apply(&p);
+            let (_, jacobian) = chain.inverse_with_jacobian(&p);
+            for axis in 0..3 {
+                let mut step = Vector3::zeros();
+                step[axis] = h;
+                let column = (chain.inverse(&(p + step)) - chain.inverse(&(p - step))) / (2.0 * h);
+                let error = (column - jacobian.column(axis)).norm();
+                assert!(
+                    error < 1e-6 * (1.0 + column.norm()),
+                    "{p} axis {axis}: {error}"
+                );
+            }
         }
     }
 

@@ -8,6 +8,7 @@
 //! its surface and negative outside. The station's deviations use the opposite sign (positive outside
 //! the material); the conversion belongs to the caller that turns these values into distances.
 
+pub mod csg;
 pub mod deform;
 pub mod formula;
 pub mod rfunc;
