@@ -10,6 +10,7 @@
 
 pub mod csg;
 pub mod deform;
+pub mod distance;
 pub mod formula;
 pub mod rfunc;
 pub mod shape;
