@@ -7,7 +7,6 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use zeroset::analysis::stats::{RunningStats, Tolerance, Verdict};
-use zeroset::geometry::fit3l::FitMethod;
 use zeroset::report::{
     write_html, write_qif, write_report, InstanceReport, MachineUse, PartReport, PointRecord,
     ProfileReport, ReferenceUse, Store, STORE_FILE,
@@ -110,8 +109,7 @@ fn report() -> PartReport {
         reference: ReferenceUse {
             path: "references/propeller.json".into(),
             taught_at: "2026-11-23T09:00:00Z".into(),
-            method: FitMethod::Orthogonal,
-            degree: 8,
+            model: "implicit polynomial of degree 8 per profile".to_string(),
         },
         distance: "exact".into(),
         compensation: "ball radius along the normal".into(),

@@ -11,6 +11,9 @@ use crate::geometry::fit3l::FitStats;
 use crate::geometry::implicit::IpModel;
 use crate::geometry::interp::{Profile, ProfileStack, StackError};
 use crate::geometry::sampling::Aabb;
+use crate::geometry::supershape::csg::Solid;
+use crate::geometry::supershape::distance::SolidDistance;
+use nalgebra::Point3;
 
 pub const FORMAT: &str = "zeroset-model";
 pub const VERSION: u32 = 1;
@@ -44,6 +47,55 @@ pub enum ReferenceModel {
     /// Parallel profiles along x blended linearly into a piecewise 3-D model (seed 003 section 4).
     #[serde(rename = "ip-stack")]
     Stack { profiles: Vec<StackProfile> },
+    /// A CSG tree of supershapes (seeds 000 and 001) with the statistics of its fit.
+    #[serde(rename = "supershape")]
+    Supershape {
+        solid: Solid,
+        fit: Option<SolidFitStats>,
+    },
+}
+
+/// How closely a supershape model follows the points it was made from: exact distances, mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidFitStats {
+    pub points: usize,
+    pub rms_distance_mm: f64,
+    pub max_distance_mm: f64,
+}
+
+impl SolidFitStats {
+    /// The exact distances of `points` to the solid; `None` without points or if a point has no foot.
+    pub fn of(distance: &SolidDistance, points: &[Point3<f64>]) -> Option<Self> {
+        let distances: Vec<f64> = points
+            .iter()
+            .map(|p| distance.foot(p).map(|f| f.distance_mm))
+            .collect::<Option<_>>()?;
+        (!distances.is_empty()).then(|| Self {
+            points: distances.len(),
+            rms_distance_mm: (distances.iter().map(|d| d * d).sum::<f64>()
+                / distances.len() as f64)
+                .sqrt(),
+            max_distance_mm: distances.iter().fold(0.0, |m, d| m.max(d.abs())),
+        })
+    }
+}
+
+/// A supershape model must bound a finite, non-empty region to be measured against.
+fn check_solid(solid: &Solid) -> Result<(), String> {
+    let bounds = solid.bounds();
+    let finite = bounds
+        .min
+        .iter()
+        .chain(bounds.max.iter())
+        .all(|c| c.is_finite());
+    if !(finite && (0..3).all(|i| bounds.min[i] < bounds.max[i])) {
+        return Err(format!(
+            "the supershape solid has no finite extent (bounds {:?} to {:?} mm); check its parameters",
+            bounds.min, bounds.max
+        ));
+    }
+    Ok(())
 }
 
 /// An implicit polynomial with the box of the data it was fitted to (where it is valid) and its statistics.
@@ -144,6 +196,7 @@ impl ModelFile {
                         .map_err(|e| format!("profile {i} (x = {} mm): {e}", p.x))
                 })
                 .and_then(|()| stack_of(profiles).map(drop).map_err(|e| e.to_string())),
+            ReferenceModel::Supershape { solid, .. } => check_solid(solid),
         };
         checked.map_err(|problem| ModelFileError::new(path, problem))?;
         Ok(file)

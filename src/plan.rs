@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
 
 use crate::analysis::NominalPoint;
-use crate::config::{PartConfig, ProfileEntry, ReferenceEntry, ScanSettings, ToleranceEntry};
+use crate::config::{PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, ToleranceEntry};
 
 /// A teach scan stops in a sphere centred this far off its start along the start normal: where the ball
 /// centre of the station's 1 mm probe sits when it touches the start, so the scan ends as it comes back
@@ -218,7 +218,7 @@ impl Plan {
         &self.part.scan
     }
 
-    pub fn reference_settings(&self) -> &ReferenceEntry {
+    pub fn reference_settings(&self) -> &ReferenceSettings {
         &self.part.reference
     }
 

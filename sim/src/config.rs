@@ -262,7 +262,12 @@ mod tests {
 
     #[test]
     fn the_shipped_configs_load() {
-        for name in ["propeller.toml", "two-machines.toml", "nut.toml"] {
+        for name in [
+            "propeller.toml",
+            "two-machines.toml",
+            "nut.toml",
+            "nut-b.toml",
+        ] {
             let config = SimConfig::load(&shipped(name)).unwrap_or_else(|e| panic!("{e}"));
             assert!(!config.machines.is_empty(), "{name}");
         }

@@ -1,8 +1,12 @@
-//! Live deviation: the signed orthogonal distance of each arriving point to its reference profile's 2-D IP.
+//! Live deviation: the signed orthogonal distance of each arriving point to its reference profile's 2-D IP, or to
+//! the reference's supershape solid (the exact 3-D Euclidean distance).
 //!
 //! A gauge is built once per profile (sampling the zero set is the expensive part, milliseconds) and shared by
 //! every scan of that profile; a scan's measurer seeds each point's foot from the previous one, so a point along a
-//! scan costs a Newton solve of a few iterations (microseconds).
+//! scan costs a Newton solve of a few iterations (microseconds). The supershape's distance is shared by every
+//! profile: one solid, sampled once.
+
+use std::sync::Arc;
 
 use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
@@ -12,6 +16,7 @@ use super::reference::Reference;
 use crate::geometry::distance::{DistanceError, ExactDistance, Foot};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
+use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::ReferenceModel;
 
 /// The zero set is sampled over the profile's data box enlarged by this on every side: it covers any deviation
@@ -26,15 +31,43 @@ const SAMPLING_CELLS: usize = 512;
 pub struct ProfileGauge {
     name: String,
     x_mm: f64,
-    model: IpModel<2>,
-    samples: ZeroSetSamples<2>,
-    edges: Vec<SharpEdge>,
+    model: GaugeModel,
+}
+
+/// What a profile's points are measured against.
+enum GaugeModel {
+    /// The profile's own 2-D IP in its (y, z) plane, and the sharp edges found on the master.
+    Ip {
+        model: IpModel<2>,
+        samples: Box<ZeroSetSamples<2>>,
+        edges: Vec<SharpEdge>,
+    },
+    /// The reference's solid, the same for every profile.
+    Solid(Arc<SolidDistance>),
 }
 
 impl ProfileGauge {
-    /// The gauge of `reference.profiles[profile]`. Panics when `profile` is out of range or the model is not a
-    /// stack, neither of which a taught or loaded reference allows (a programming error).
-    pub fn new(reference: &Reference, profile: usize) -> Self {
+    /// The gauges of every profile of a taught or loaded reference, in its order.
+    pub fn all(reference: &Reference) -> Vec<Self> {
+        let solid = match &reference.model.model {
+            ReferenceModel::Supershape { solid, .. } => Some(Arc::new(SolidDistance::new(solid))),
+            _ => None,
+        };
+        (0..reference.profiles.len())
+            .map(|profile| match &solid {
+                Some(distance) => Self {
+                    name: reference.profiles[profile].name.clone(),
+                    x_mm: reference.profiles[profile].x_mm,
+                    model: GaugeModel::Solid(Arc::clone(distance)),
+                },
+                None => Self::of_ip_profile(reference, profile),
+            })
+            .collect()
+    }
+
+    /// The gauge of `reference.profiles[profile]` of an IP stack. Panics when `profile` is out of range or the
+    /// model is not a stack, neither of which a taught or loaded reference allows (a programming error).
+    fn of_ip_profile(reference: &Reference, profile: usize) -> Self {
         let ReferenceModel::Stack { profiles } = &reference.model.model else {
             panic!(
                 "the reference of part '{}' has no stack of profile models",
@@ -51,9 +84,11 @@ impl ProfileGauge {
         Self {
             name: taught.name.clone(),
             x_mm: taught.x_mm,
-            samples: ZeroSetSamples::new(&fitted.ip, &bounds, SAMPLING_CELLS),
-            model: fitted.ip.clone(),
-            edges: taught.edges.clone(),
+            model: GaugeModel::Ip {
+                samples: Box::new(ZeroSetSamples::new(&fitted.ip, &bounds, SAMPLING_CELLS)),
+                model: fitted.ip.clone(),
+                edges: taught.edges.clone(),
+            },
         }
     }
 
@@ -98,22 +133,48 @@ impl ScanGauge<'_> {
     /// Signed deviation (mm, positive outside) of a compensated part-frame point; its distance from the profile's
     /// plane is returned too (a point far off the plane means a wrong transform or a wrong profile).
     ///
-    /// The point is measured in the profile's plane: its x is set aside, as the profile's model knows nothing of
-    /// x. A point with a non-finite coordinate has no foot.
+    /// Against a profile's IP the point is measured in the profile's plane: its x is set aside, as the profile's
+    /// model knows nothing of x. Against a solid it is measured in 3-D. A point with a non-finite coordinate has
+    /// no foot.
     pub fn measure(&mut self, surface: &Point3<f64>) -> Result<PointDeviation, DistanceError> {
         let off_plane_mm = surface.x - self.gauge.x_mm;
-        let in_plane = Vector2::new(surface.y, surface.z);
-        if !(off_plane_mm.is_finite() && in_plane.iter().all(|c| c.is_finite())) {
+        if !(off_plane_mm.is_finite() && surface.iter().all(|c| c.is_finite())) {
             return Err(DistanceError::NoFootPoint);
         }
-        let exact = ExactDistance::new(&self.gauge.model, &self.gauge.samples);
+        match &self.gauge.model {
+            GaugeModel::Ip {
+                model,
+                samples,
+                edges,
+            } => self.measure_in_plane(surface, model, samples, edges),
+            GaugeModel::Solid(distance) => {
+                let foot = distance.foot(surface).ok_or(DistanceError::NoFootPoint)?;
+                Ok(PointDeviation {
+                    deviation_mm: foot.distance_mm,
+                    off_plane_mm,
+                    foot: foot.point.coords.into(),
+                })
+            }
+        }
+    }
+
+    fn measure_in_plane(
+        &mut self,
+        surface: &Point3<f64>,
+        model: &IpModel<2>,
+        samples: &ZeroSetSamples<2>,
+        edges: &[SharpEdge],
+    ) -> Result<PointDeviation, DistanceError> {
+        let off_plane_mm = surface.x - self.gauge.x_mm;
+        let in_plane = Vector2::new(surface.y, surface.z);
+        let exact = ExactDistance::new(model, samples);
         let previous = self.previous.as_ref().map(|(point, foot)| (point, foot));
         // A point without a foot leaves the previous one in place: the next point still starts from a good foot.
         let foot = exact.foot(&in_plane, previous)?;
         self.previous = Some((in_plane, foot));
         // Near a sharp edge the model cannot stand for the part (its zero set crosses itself there and goes on):
         // there the distance is to the wedge of the edge's faces, and the nearest point reported is the edge.
-        let at_edge = self.gauge.edges.iter().find_map(|edge| {
+        let at_edge = edges.iter().find_map(|edge| {
             edge.distance(&in_plane, &foot.point)
                 .map(|distance| (distance, Vector2::from(edge.apex)))
         });
@@ -146,7 +207,7 @@ mod tests {
         let mut worst: f64 = 0.0;
         let mut seeded = (0, std::time::Duration::ZERO);
         for (index, ellipse) in Ellipse::stack().iter().enumerate() {
-            let gauge = ProfileGauge::new(reference, index);
+            let gauge = &ProfileGauge::all(reference)[index];
             assert_eq!(gauge.name(), ellipse.name());
             for offset in [0.3, -0.3] {
                 let mut scan = gauge.scan();
@@ -189,7 +250,7 @@ mod tests {
     fn a_point_with_no_coordinates_has_no_foot_and_the_scan_goes_on() {
         let reference = taught_ellipses();
         let ellipse = &Ellipse::stack()[2];
-        let gauge = ProfileGauge::new(reference, 2);
+        let gauge = &ProfileGauge::all(reference)[2];
         let mut scan = gauge.scan();
         let before = scan.measure(&ellipse.offset_point(0.1, 0.2)).unwrap();
         assert_eq!(

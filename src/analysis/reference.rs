@@ -4,7 +4,7 @@
 
 use std::time::SystemTime;
 
-use nalgebra::{Point3, Vector2, Vector3};
+use nalgebra::{Point2, Point3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 mod file;
@@ -17,20 +17,74 @@ use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions, FitStats, 
 use crate::geometry::interp::StackError;
 use crate::geometry::normals::ordered_profile_normals;
 use crate::geometry::poly::MAX_DEGREE;
-use crate::model_file::{stack_of, FittedIp, ModelFile, ReferenceModel, StackProfile};
+use crate::geometry::supershape::csg::{Node, Solid};
+use crate::geometry::supershape::distance::SolidDistance;
+use crate::geometry::supershape::prism::{fit_prism_section, PrismFitError};
+use crate::model_file::{
+    stack_of, FittedIp, ModelFile, ReferenceModel, SolidFitStats, StackProfile,
+};
 
 pub const FORMAT: &str = "zeroset-reference";
-pub const VERSION: u32 = 1;
+/// 2: the settings name the kind of model ("kind": "ip" or "supershape").
+pub const VERSION: u32 = 2;
 pub const UNITS: &str = "mm";
 
-/// How a reference is taught.
+/// How a reference is taught: the kind of model and its parameters, as the part config's [reference]
+/// gives them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ReferenceSettings {
-    /// Degree of each profile's polynomial (the stack between profiles is one degree higher).
-    pub degree: usize,
-    pub method: FitMethod,
-    /// Largest distance between consecutive nominal points, mm.
-    pub nominal_spacing_mm: f64,
+#[serde(tag = "kind", deny_unknown_fields)]
+pub enum ReferenceSettings {
+    /// An implicit polynomial per profile, blended along x into one surface (seed 003).
+    #[serde(rename = "ip")]
+    ImplicitPolynomial {
+        /// Degree of each profile's polynomial (the stack between profiles is one degree higher).
+        degree: usize,
+        method: FitMethod,
+        /// Largest distance between consecutive nominal points, mm.
+        nominal_spacing_mm: f64,
+    },
+    /// A superformula prism across the profiles' planes (seed 000), for extruded parts such as nuts.
+    #[serde(rename = "supershape")]
+    Supershape {
+        /// The number of lobes (6 for a hex nut); found from the scans when not given.
+        #[serde(default)]
+        symmetry: Option<usize>,
+        nominal_spacing_mm: f64,
+    },
+}
+
+impl ReferenceSettings {
+    pub fn nominal_spacing_mm(&self) -> f64 {
+        match *self {
+            Self::ImplicitPolynomial {
+                nominal_spacing_mm, ..
+            }
+            | Self::Supershape {
+                nominal_spacing_mm, ..
+            } => nominal_spacing_mm,
+        }
+    }
+
+    /// The model in words, for reports.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::ImplicitPolynomial { degree, method, .. } => {
+                format!(
+                    "implicit polynomial of degree {degree} per profile, {}",
+                    method.describe()
+                )
+            }
+            Self::Supershape { symmetry, .. } => format!(
+                "superformula prism across the profiles (seed 000), {} lobes{}",
+                symmetry.map_or("its".to_string(), |m| m.to_string()),
+                if symmetry.is_some() {
+                    ""
+                } else {
+                    " found from the scans"
+                }
+            ),
+        }
+    }
 }
 
 /// One scanned profile of the master, already compensated and in the part frame.
@@ -107,6 +161,8 @@ pub enum TeachError {
     },
     #[error("the profiles do not blend into one 3-D model: {0}")]
     Stack(#[from] StackError),
+    #[error("the profiles do not make a superformula prism: {0}")]
+    Prism(#[from] PrismFitError),
 }
 
 /// Fits one 2-D IP per profile (in the (y, z) plane of the profile, from the points' y, z and the normals' y, z),
@@ -120,7 +176,7 @@ pub fn teach(
     profiles: &[MasterProfile],
     settings: &ReferenceSettings,
 ) -> Result<Reference, TeachError> {
-    let spacing_mm = settings.nominal_spacing_mm;
+    let spacing_mm = settings.nominal_spacing_mm();
     if !(spacing_mm.is_finite() && spacing_mm > 0.0) {
         return Err(TeachError::BadSpacing { spacing_mm });
     }
@@ -136,11 +192,51 @@ pub fn teach(
             });
         }
     }
-    let options = FitOptions::new(settings.degree, settings.method);
+    let (model, method) = match *settings {
+        ReferenceSettings::ImplicitPolynomial { degree, method, .. } => (
+            fit_stack(profiles, &FitOptions::new(degree, method))?,
+            method.describe().to_string(),
+        ),
+        ReferenceSettings::Supershape { symmetry, .. } => (
+            fit_prism(profiles, symmetry)?,
+            "superformula prism: Levenberg-Marquardt on the radial residual (mm)".to_string(),
+        ),
+    };
+    let with_edges = matches!(model, ReferenceModel::Stack { .. });
+    let taught = profiles
+        .iter()
+        .map(|p| ReferenceProfile {
+            name: p.name.clone(),
+            x_mm: p.x_mm,
+            nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
+            edges: if with_edges {
+                profile_edges(p)
+            } else {
+                Vec::new()
+            },
+        })
+        .collect();
+    Ok(Reference {
+        format: FORMAT.to_string(),
+        version: VERSION,
+        units: UNITS.to_string(),
+        part: part.to_string(),
+        taught_at: humantime::format_rfc3339_seconds(SystemTime::now()).to_string(),
+        settings: *settings,
+        model: ModelFile::new(method, model),
+        profiles: taught,
+    })
+}
+
+/// One 2-D IP per profile, blended into the 3-D stack (which must succeed: checked with stack_of).
+fn fit_stack(
+    profiles: &[MasterProfile],
+    options: &FitOptions,
+) -> Result<ReferenceModel, TeachError> {
     let fitted: Vec<StackProfile> = std::thread::scope(|scope| {
         let fits: Vec<_> = profiles
             .iter()
-            .map(|profile| scope.spawn(|| fit_profile(profile, &options)))
+            .map(|profile| scope.spawn(|| fit_profile(profile, options)))
             .collect();
         fits.into_iter()
             .map(|fit| {
@@ -151,28 +247,46 @@ pub fn teach(
     })?;
     let fitted = to_common_degree(fitted);
     stack_of(&fitted)?;
-    let taught = profiles
+    Ok(ReferenceModel::Stack { profiles: fitted })
+}
+
+/// The model ends this far beyond the outermost profiles along x: nothing is measured there, and a point
+/// of an outer profile deviating by up to this much still has the side wall, not an end, as its nearest
+/// surface.
+const PRISM_END_MARGIN_MM: f64 = 5.0;
+
+/// A superformula prism whose cross section fits every profile's points at once (they are sections of
+/// one extruded outline), its axis along x over the profiles plus a margin.
+fn fit_prism(
+    profiles: &[MasterProfile],
+    symmetry: Option<usize>,
+) -> Result<ReferenceModel, TeachError> {
+    let in_plane: Vec<Point2<f64>> = profiles
         .iter()
-        .map(|p| ReferenceProfile {
-            name: p.name.clone(),
-            x_mm: p.x_mm,
-            nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
-            edges: profile_edges(p),
-        })
+        .flat_map(|p| p.points.iter().map(|q| Point2::new(q.y, q.z)))
         .collect();
-    Ok(Reference {
-        format: FORMAT.to_string(),
-        version: VERSION,
-        units: UNITS.to_string(),
-        part: part.to_string(),
-        taught_at: humantime::format_rfc3339_seconds(SystemTime::now()).to_string(),
-        settings: *settings,
-        model: ModelFile::new(
-            settings.method.describe(),
-            ReferenceModel::Stack { profiles: fitted },
-        ),
-        profiles: taught,
-    })
+    let section = fit_prism_section(&in_plane, symmetry)?;
+    let (first, last) = profiles
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.x_mm), hi.max(p.x_mm))
+        });
+    let (shape, place) =
+        section.supershape((first - PRISM_END_MARGIN_MM, last + PRISM_END_MARGIN_MM));
+    tracing::info!(
+        lobes = section.formula.m,
+        n1 = section.formula.n1,
+        n2 = section.formula.n2,
+        n3 = section.formula.n3,
+        size_mm = section.size_mm,
+        turn_deg = section.turn.to_degrees(),
+        radial_rms_mm = section.rms_mm,
+        "superformula prism fitted"
+    );
+    let solid = Solid::new(Node::supershape(shape, place));
+    let points: Vec<Point3<f64>> = profiles.iter().flat_map(|p| p.points.clone()).collect();
+    let fit = SolidFitStats::of(&SolidDistance::new(&solid), &points);
+    Ok(ReferenceModel::Supershape { solid, fit })
 }
 
 /// The 2-D fit of one profile in its (y, z) plane, with warnings for the statistics an operator should see.

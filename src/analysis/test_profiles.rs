@@ -12,7 +12,7 @@ use crate::geometry::fit3l::FitMethod;
 
 /// Points per taught profile.
 pub const TAUGHT_POINTS: usize = 240;
-pub const SETTINGS: ReferenceSettings = ReferenceSettings {
+pub const SETTINGS: ReferenceSettings = ReferenceSettings::ImplicitPolynomial {
     degree: 4,
     method: FitMethod::Orthogonal,
     nominal_spacing_mm: 5.0,

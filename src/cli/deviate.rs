@@ -15,6 +15,7 @@ use crate::geometry::distance::{
 };
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
+use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{stack_of, ModelFile, ReferenceModel};
 use crate::points::{read_points, PointSet};
 
@@ -74,6 +75,26 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
                         .map(|q| exact.foot(q).map(|f| f.distance))
                         .collect()
                 });
+                (coordinates(p), distances)
+            }
+            (ReferenceModel::Supershape { solid, .. }, PointSet::Spatial(p)) => {
+                if method != DistanceMethod::Exact {
+                    anyhow::bail!(
+                        "{}: a supershape model is measured by the exact Euclidean distance only; \
+                         leave out --distance or give --distance exact",
+                        args.model.display()
+                    );
+                }
+                let exact = SolidDistance::new(solid);
+                let distances = p
+                    .iter()
+                    .map(|q| {
+                        exact
+                            .foot(&nalgebra::Point3::from(*q))
+                            .map(|f| f.distance_mm)
+                            .ok_or(DistanceError::NoFootPoint)
+                    })
+                    .collect();
                 (coordinates(p), distances)
             }
             (ReferenceModel::Profile(_), PointSet::Spatial(_)) => {

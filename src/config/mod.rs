@@ -14,8 +14,7 @@ use std::path::{Component, Path, PathBuf};
 use serde::de::DeserializeOwned;
 
 pub use part::{
-    Instances, PartConfig, ProfileEntry, ReferenceEntry, ReferenceKind, ScanSettings,
-    ToleranceEntry,
+    Instances, PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, ToleranceEntry,
 };
 pub use station::{Control, Folders, MachineEntry, Pose, ProbeSettings, Safety, StationConfig};
 

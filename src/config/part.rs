@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{finite, read_toml, ConfigError};
-use crate::geometry::fit3l::FitMethod;
+pub use crate::analysis::ReferenceSettings;
 
 /// The whole part file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -21,7 +21,8 @@ pub struct PartConfig {
     /// In increasing x; at least two, since the reference surface interpolates between profiles.
     pub profiles: Vec<ProfileEntry>,
     pub scan: ScanSettings,
-    pub reference: ReferenceEntry,
+    /// The reference model fitted to the master's profiles (`kind = "ip"` or `"supershape"`).
+    pub reference: ReferenceSettings,
     pub tolerance: ToleranceEntry,
 }
 
@@ -69,26 +70,6 @@ pub struct ScanSettings {
     pub min_radius_mm: f64,
     /// A curve scan reports a point wherever the path turns by more than this.
     pub max_angle_deg: f64,
-}
-
-/// The reference model fitted to the master's profiles.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ReferenceEntry {
-    pub kind: ReferenceKind,
-    /// The implicit polynomial's degree: even, since an odd degree has no closed zero set.
-    pub degree: usize,
-    pub method: FitMethod,
-    /// Spacing of the nominal points sampled on each fitted profile, which the inspect scans follow.
-    pub nominal_spacing_mm: f64,
-}
-
-/// The kinds of reference model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum ReferenceKind {
-    /// An implicit polynomial per profile, blended along x into one surface (seed 003).
-    #[serde(rename = "ip")]
-    ImplicitPolynomial,
 }
 
 /// The band a deviation must lie in for the instance to pass.
@@ -143,7 +124,7 @@ impl PartConfig {
             }
         }
         self.scan.check()?;
-        self.reference.check()?;
+        check_reference(&self.reference)?;
         let tolerance = &self.tolerance;
         if !(finite(&[tolerance.lower_mm, tolerance.upper_mm])
             && tolerance.lower_mm < tolerance.upper_mm)
@@ -263,22 +244,33 @@ impl ScanSettings {
     }
 }
 
-impl ReferenceEntry {
-    fn check(&self) -> Result<(), String> {
-        if self.degree < 2 || self.degree % 2 == 1 {
-            return Err(format!(
-                "[reference] degree = {}: a closed profile needs an even degree of at least 2",
-                self.degree
-            ));
+/// What serde cannot check in [reference].
+fn check_reference(reference: &ReferenceSettings) -> Result<(), String> {
+    match *reference {
+        ReferenceSettings::ImplicitPolynomial { degree, .. } => {
+            if degree < 2 || degree % 2 == 1 {
+                return Err(format!(
+                    "[reference] degree = {degree}: a closed profile needs an even degree of at least 2"
+                ));
+            }
         }
-        if !(self.nominal_spacing_mm > 0.0 && self.nominal_spacing_mm.is_finite()) {
-            return Err(format!(
-                "[reference] nominal_spacing_mm = {} must be above zero",
-                self.nominal_spacing_mm
-            ));
+        ReferenceSettings::Supershape { symmetry, .. } => {
+            if symmetry.is_some_and(|m| !(2..=12).contains(&m)) {
+                return Err(format!(
+                    "[reference] symmetry = {}: give the part's number of lobes, from 2 to 12 (6 for a hex \
+                     nut), or leave it out to have it found from the scans",
+                    symmetry.unwrap_or_default()
+                ));
+            }
         }
-        Ok(())
     }
+    let spacing = reference.nominal_spacing_mm();
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Err(format!(
+            "[reference] nominal_spacing_mm = {spacing} must be above zero"
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -326,13 +318,46 @@ mod tests {
         assert_eq!(xs, [100.0, 200.0, 300.0, 400.0, 500.0]);
         let names: Vec<&str> = part.profiles.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, ["r100", "r200", "r300", "r400", "r500"]);
-        assert_eq!(part.reference.degree, 8);
-        assert_eq!(part.reference.method, FitMethod::Orthogonal);
-        assert_eq!(part.reference.kind, ReferenceKind::ImplicitPolynomial);
+        assert_eq!(
+            part.reference,
+            ReferenceSettings::ImplicitPolynomial {
+                degree: 8,
+                method: crate::geometry::fit3l::FitMethod::Orthogonal,
+                nominal_spacing_mm: 2.0
+            }
+        );
         assert_eq!(
             (part.tolerance.lower_mm, part.tolerance.upper_mm),
             (-0.1, 0.1)
         );
+    }
+
+    /// The nut's drawing puts each teach start on the middle of a flat, 40 mm from the axis; the simulated
+    /// nut, stood up by config/station-nut.toml, is made 0.2% oversize, so the start lies 0.08 mm inside
+    /// it, with the flat's normal where the drawing says.
+    #[test]
+    fn the_nut_starts_on_the_flats_of_the_simulated_nut() {
+        let part = PartConfig::load(&repo("config/parts/nut.toml")).unwrap();
+        let station = crate::config::StationConfig::load(&repo("config/station-nut.toml")).unwrap();
+        let sim = SimConfig::load(&repo("config/sims/nut.toml")).unwrap();
+        let truth = sim.parts["nut"].build().unwrap();
+        let to_machine = station.part_to_machine.isometry();
+        for profile in &part.profiles {
+            let start = to_machine * Point3::from(profile.start_mm);
+            let nearest = truth.nearest(&start);
+            assert!(
+                (nearest.signed_distance + 0.08).abs() < 0.005,
+                "profile {}: start {start} is {:.4} mm from the nut",
+                profile.name,
+                nearest.signed_distance
+            );
+            let normal = to_machine * Vector3::from(profile.start_normal);
+            assert!(
+                nearest.normal.dot(&normal) > 0.999,
+                "profile {}",
+                profile.name
+            );
+        }
     }
 
     /// The drawing's start points were computed once from the simulator's blade A; if the simulated
@@ -381,8 +406,12 @@ mod tests {
             text.replace("kind = \"ip\"", "kind = \"supershape\""),
         )
         .unwrap();
+        // A supershape reference has no polynomial degree: the key is named.
         let message = PartConfig::load(&path).unwrap_err().to_string();
-        assert!(message.contains("supershape"), "{message}");
+        assert!(message.contains("unknown field `degree`"), "{message}");
+        std::fs::write(&path, text.replace("kind = \"ip\"", "kind = \"gear\"")).unwrap();
+        let message = PartConfig::load(&path).unwrap_err().to_string();
+        assert!(message.contains("unknown variant `gear`"), "{message}");
     }
 
     #[test]
@@ -414,8 +443,22 @@ mod tests {
         let message = refusal(|c| c.profiles[3].direction = [0.0, 0.0, -2.0]);
         assert!(message.contains("profile r400: direction"), "{message}");
 
-        let message = refusal(|c| c.reference.degree = 7);
+        let message = refusal(|c| {
+            c.reference = ReferenceSettings::ImplicitPolynomial {
+                degree: 7,
+                method: crate::geometry::fit3l::FitMethod::Orthogonal,
+                nominal_spacing_mm: 2.0,
+            }
+        });
         assert!(message.contains("even degree"), "{message}");
+
+        let message = refusal(|c| {
+            c.reference = ReferenceSettings::Supershape {
+                symmetry: Some(1),
+                nominal_spacing_mm: 2.0,
+            }
+        });
+        assert!(message.contains("symmetry = 1"), "{message}");
 
         let message = refusal(|c| c.tolerance.lower_mm = 0.2);
         assert!(message.contains("must be below upper_mm"), "{message}");

@@ -87,23 +87,27 @@ pub struct Control {
     pub socket: PathBuf,
 }
 
-/// A rigid placement on the table: a shift and a turn about the machine's z axis. Every key defaults
-/// to zero, so `{ z_mm = 12.5 }` is a fixture 12.5 mm high.
+/// A rigid placement on the table: a tilt about the machine's y axis, a turn about its z axis and a
+/// shift. Every key defaults to zero, so `{ z_mm = 12.5 }` is a fixture 12.5 mm high. The tilt stands a
+/// part up whose profiles are sections across its length: profiles are the planes x = const of the part
+/// frame, so a nut or a gear scanned in horizontal sections has its part x axis up, `rot_y_deg = -90`.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Pose {
     pub x_mm: f64,
     pub y_mm: f64,
     pub z_mm: f64,
+    pub rot_y_deg: f64,
     pub rot_z_deg: f64,
 }
 
 impl Pose {
-    /// The turn about z first, then the shift.
+    /// The tilt about y first, then the turn about z, then the shift.
     pub fn isometry(&self) -> Isometry3<f64> {
         Isometry3::from_parts(
             Translation3::new(self.x_mm, self.y_mm, self.z_mm),
-            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.rot_z_deg.to_radians()),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.rot_z_deg.to_radians())
+                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), self.rot_y_deg.to_radians()),
         )
     }
 }
@@ -168,7 +172,13 @@ impl StationConfig {
             ));
         }
         let pose = &self.part_to_machine;
-        if !finite(&[pose.x_mm, pose.y_mm, pose.z_mm, pose.rot_z_deg]) {
+        if !finite(&[
+            pose.x_mm,
+            pose.y_mm,
+            pose.z_mm,
+            pose.rot_y_deg,
+            pose.rot_z_deg,
+        ]) {
             return Err(format!(
                 "part_to_machine {pose:?} has a value that is not a finite number"
             ));
@@ -340,11 +350,24 @@ mod tests {
             y_mm: -5.0,
             z_mm: 12.5,
             rot_z_deg: 90.0,
+            ..Pose::default()
         };
         let moved = pose.isometry() * Point3::new(100.0, 0.0, 0.0);
         assert!(
             (moved - Point3::new(10.0, 95.0, 12.5)).norm() < 1e-12,
             "{moved}"
+        );
+        // Stood up: the part's x axis (its length, across the profiles) points up, its z along -x.
+        let standing = Pose {
+            rot_y_deg: -90.0,
+            ..pose
+        };
+        let up = standing.isometry() * Point3::new(20.0, 0.0, 0.0);
+        assert!((up - Point3::new(10.0, -5.0, 32.5)).norm() < 1e-12, "{up}");
+        let side = standing.isometry() * Point3::new(0.0, 0.0, 40.0);
+        assert!(
+            (side - Point3::new(10.0, -45.0, 12.5)).norm() < 1e-12,
+            "{side}"
         );
         let (_dir, path) = edited(|t| {
             t.replace(

@@ -63,16 +63,7 @@ fn header_html(report: &PartReport) -> String {
         ("started", report.started.clone()),
         ("finished", report.finished.clone()),
         ("machines", machines.join("; ")),
-        (
-            "reference",
-            format!(
-                "{} (taught {}; degree {}, {})",
-                reference.path,
-                reference.taught_at,
-                reference.degree,
-                reference.method.describe()
-            ),
-        ),
+        ("reference", reference.describe()),
         ("distance", report.distance.clone()),
         ("compensation", report.compensation.clone()),
         ("tolerance", tolerance_text(&report.tolerance)),

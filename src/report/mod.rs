@@ -17,7 +17,6 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
-use crate::geometry::fit3l::FitMethod;
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
 pub use qif::{write_qif, QIF_FILE};
@@ -69,8 +68,15 @@ pub struct MachineUse {
 pub struct ReferenceUse {
     pub path: String,
     pub taught_at: String,
-    pub method: FitMethod,
-    pub degree: usize,
+    /// The kind of model and how it was fitted, in words.
+    pub model: String,
+}
+
+impl ReferenceUse {
+    /// One line for the reports' headers: where, when, what.
+    pub fn describe(&self) -> String {
+        format!("{} (taught {}; {})", self.path, self.taught_at, self.model)
+    }
 }
 
 /// One instance (blade) of the part: its statistics over all its profiles and their reports.

@@ -50,16 +50,7 @@ pub fn summary_text(report: &PartReport) -> String {
                 deviation(report.tolerance.upper_mm)
             ),
         ),
-        (
-            "reference",
-            format!(
-                "{} (taught {}; degree {}, {})",
-                reference.path,
-                reference.taught_at,
-                reference.degree,
-                reference.method.describe()
-            ),
-        ),
+        ("reference", reference.describe()),
         ("distance", report.distance.clone()),
         ("compensation", report.compensation.clone()),
         ("machines", machines.join("; ")),

@@ -91,8 +91,8 @@ pub(super) fn sample_report() -> PartReport {
         reference: ReferenceUse {
             path: "/var/lib/zeroset/references/propeller-3.json".to_string(),
             taught_at: "2025-03-01T08:00:00Z".to_string(),
-            method: FitMethod::Orthogonal,
-            degree: 4,
+            model: "implicit polynomial of degree 4 per profile, ridge-regularised 3L refined by orthogonal distances"
+                .to_string(),
         },
         distance: "exact orthogonal distance to each profile's 2-D IP".to_string(),
         compensation: "ball radius along the reported normal".to_string(),

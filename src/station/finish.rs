@@ -11,10 +11,12 @@ use super::job::job_scans;
 use super::journal::{file_stem, JobDir, JobRecord};
 use super::pipeline::scan_ref;
 use crate::analysis::deviation::ProfileGauge;
-use crate::analysis::reference::{teach, MasterProfile, Reference, ReferenceSettings};
+use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
 use crate::analysis::surface_point;
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
+use crate::geometry::supershape::distance::SolidDistance;
+use crate::model_file::{ReferenceModel, SolidFitStats};
 use crate::plan::Plan;
 use crate::report::{
     write_html, write_qif, write_report, InstanceReport, MachineUse, PartReport, PointRecord,
@@ -60,13 +62,8 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
             normals,
         });
     }
-    let entry = plan.reference_settings();
-    let settings = ReferenceSettings {
-        degree: entry.degree,
-        method: entry.method,
-        nominal_spacing_mm: entry.nominal_spacing_mm,
-    };
-    let reference = teach(plan.part(), &profiles, &settings).map_err(|e| e.to_string())?;
+    let reference =
+        teach(plan.part(), &profiles, plan.reference_settings()).map_err(|e| e.to_string())?;
     if let Some(folder) = path.parent() {
         std::fs::create_dir_all(folder)
             .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
@@ -79,24 +76,44 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
     })
 }
 
+/// How closely the reference follows each master profile: a stack's own fit statistics, or the exact distances
+/// of each profile's points to the solid.
 fn reference_fits(reference: &Reference, profiles: &[MasterProfile]) -> Vec<ProfileFit> {
-    let crate::model_file::ReferenceModel::Stack { profiles: fitted } = &reference.model.model
-    else {
-        return Vec::new();
+    let fit = |master: &MasterProfile, rms_mm: Option<f64>, max_mm: Option<f64>| ProfileFit {
+        profile: master.name.clone(),
+        points: master.points.len(),
+        rms_mm: rms_mm.unwrap_or(f64::NAN),
+        max_mm: max_mm.unwrap_or(f64::NAN),
     };
-    fitted
-        .iter()
-        .zip(profiles)
-        .map(|(stack, master)| {
-            let stats = stack.fitted.fit.as_ref();
-            ProfileFit {
-                profile: master.name.clone(),
-                points: master.points.len(),
-                rms_mm: stats.map_or(f64::NAN, |s| s.rms_distance_mm),
-                max_mm: stats.map_or(f64::NAN, |s| s.max_distance_mm),
-            }
-        })
-        .collect()
+    match &reference.model.model {
+        ReferenceModel::Stack { profiles: fitted } => fitted
+            .iter()
+            .zip(profiles)
+            .map(|(stack, master)| {
+                let stats = stack.fitted.fit.as_ref();
+                fit(
+                    master,
+                    stats.map(|s| s.rms_distance_mm),
+                    stats.map(|s| s.max_distance_mm),
+                )
+            })
+            .collect(),
+        ReferenceModel::Supershape { solid, .. } => {
+            let distance = SolidDistance::new(solid);
+            profiles
+                .iter()
+                .map(|master| {
+                    let stats = SolidFitStats::of(&distance, &master.points);
+                    fit(
+                        master,
+                        stats.map(|s| s.rms_distance_mm),
+                        stats.map(|s| s.max_distance_mm),
+                    )
+                })
+                .collect()
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// What an inspection's report needs besides its scans.
@@ -208,10 +225,15 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         reference: ReferenceUse {
             path: inputs.reference_path.display().to_string(),
             taught_at: inputs.reference.taught_at.clone(),
-            method: settings.method,
-            degree: settings.degree,
+            model: settings.describe(),
         },
-        distance: "exact orthogonal distance to each profile's 2-D implicit polynomial, in the master's frame".into(),
+        distance: match inputs.reference.model.model {
+            ReferenceModel::Supershape { .. } => {
+                "exact Euclidean distance to the supershape solid, in the master's frame".into()
+            }
+            _ => "exact orthogonal distance to each profile's 2-D implicit polynomial, in the master's frame"
+                .into(),
+        },
         compensation: "ball centre moved back one ball radius along the reported surface normal".into(),
         tolerance: inputs.tolerance,
         instances,

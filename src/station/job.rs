@@ -112,9 +112,7 @@ pub fn load_reference(
             plan.profile_names().len()
         )));
     }
-    let gauges = (0..reference.profiles.len())
-        .map(|k| ProfileGauge::new(&reference, k))
-        .collect();
+    let gauges = ProfileGauge::all(&reference);
     Ok((Arc::new(reference), Arc::new(gauges)))
 }
 

@@ -23,13 +23,20 @@ pub struct Station {
 }
 
 impl Station {
-    /// The simulator of config/sims/`sim_config` and a daemon driving all its machines.
+    /// The simulator of config/sims/`sim_config` and a daemon driving all its machines, set up as
+    /// config/station.toml (the propeller's station).
     pub fn start(sim_config: &str) -> Station {
+        Station::start_as(sim_config, "station.toml")
+    }
+
+    /// The simulator of config/sims/`sim_config` and a daemon set up as config/`station_config`, its machines
+    /// those of the simulator.
+    pub fn start_as(sim_config: &str, station_config: &str) -> Station {
         let root = tempfile::tempdir().expect("a temporary folder");
         let ports = root.path().join("ports");
         let sim = Sim::start_linked(sim_config, &ports);
         let text = zeroset::cli::demo::station_for_simulator(
-            Path::new(&config("station.toml")),
+            Path::new(&config(station_config)),
             &sim.machines(),
             &ports,
             root.path(),
@@ -86,7 +93,11 @@ impl Station {
     }
 
     pub fn reference(&self) -> PathBuf {
-        self.data().join("references").join("propeller.json")
+        self.reference_of("propeller")
+    }
+
+    pub fn reference_of(&self, part: &str) -> PathBuf {
+        self.data().join("references").join(format!("{part}.json"))
     }
 
     /// `kill -9`: no chance to tidy up.
@@ -150,9 +161,14 @@ impl Station {
         watcher
     }
 
-    /// The report of the newest inspection of `serial`.
+    /// The report of the newest inspection of the propeller `serial`.
     pub fn report(&self, serial: &str) -> (PathBuf, PartReport) {
-        let dir = std::fs::read_dir(self.reports().join("propeller").join(serial))
+        self.report_of("propeller", serial)
+    }
+
+    /// The report of the newest inspection of `part` `serial`.
+    pub fn report_of(&self, part: &str, serial: &str) -> (PathBuf, PartReport) {
+        let dir = std::fs::read_dir(self.reports().join(part).join(serial))
             .expect("a report folder for the serial")
             .map(|e| e.unwrap().path())
             .max()

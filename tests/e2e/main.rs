@@ -5,6 +5,7 @@ mod daemon;
 mod errors;
 mod fit_and_deviate;
 mod machine_link;
+mod nut;
 mod readme;
 mod sim;
 mod station;

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::{Reference, FORMAT, UNITS, VERSION};
+use super::{Reference, ReferenceSettings, FORMAT, UNITS, VERSION};
 use crate::fsutil::write_atomically;
 use crate::model_file::{self, stack_of, FittedIp, ReferenceModel};
 
@@ -78,10 +78,20 @@ impl Reference {
                 model_file::VERSION
             ));
         }
-        let ReferenceModel::Stack { profiles } = &self.model.model else {
-            return Err(
-                "model.kind must be 'ip-stack' (one profile model per taught profile)".into(),
-            );
+        let profiles = match (&self.model.model, &self.settings) {
+            (ReferenceModel::Stack { profiles }, ReferenceSettings::ImplicitPolynomial { .. }) => {
+                profiles
+            }
+            (ReferenceModel::Supershape { .. }, ReferenceSettings::Supershape { .. }) => {
+                return Ok(());
+            }
+            _ => {
+                return Err(format!(
+                    "settings.kind {} does not match model.kind (an ip reference holds an \
+                     'ip-stack', a supershape reference a 'supershape')",
+                    serde_json::to_value(self.settings).expect("settings serialise")["kind"]
+                ))
+            }
         };
         if profiles.len() != self.profiles.len() {
             return Err(format!(

@@ -58,11 +58,11 @@ fn a_saved_reference_loads_as_it_was_and_measures_the_same() {
     let loaded = Reference::load(&path).unwrap();
     assert_eq!(&loaded, reference, "every number round-trips exactly");
     let point = Ellipse::stack()[1].offset_point(2.0, 0.25);
-    let before = ProfileGauge::new(reference, 1)
+    let before = ProfileGauge::all(reference)[1]
         .scan()
         .measure(&point)
         .unwrap();
-    let after = ProfileGauge::new(&loaded, 1)
+    let after = ProfileGauge::all(&loaded)[1]
         .scan()
         .measure(&point)
         .unwrap();
@@ -79,9 +79,9 @@ fn a_reference_file_that_does_not_match_is_refused_by_what_is_wrong() {
         reference.save(&path).unwrap();
         Reference::load(&path).unwrap_err().to_string()
     };
-    let error = refuse(&|r| r.version = 2);
+    let error = refuse(&|r| r.version = 1);
     assert!(
-        error.contains("bad-reference.json") && error.contains("version 2"),
+        error.contains("bad-reference.json") && error.contains("version 1"),
         "{error}"
     );
     let error = refuse(&|r| r.units = "inch".into());
@@ -107,6 +107,13 @@ fn a_reference_file_that_does_not_match_is_refused_by_what_is_wrong() {
         error.contains("profile 0 'x100'") && error.contains("scale is 0"),
         "{error}"
     );
+    let error = refuse(&|r| {
+        r.settings = ReferenceSettings::Supershape {
+            symmetry: None,
+            nominal_spacing_mm: 2.0,
+        }
+    });
+    assert!(error.contains("settings.kind \"supershape\""), "{error}");
     std::fs::write(&path, "{\"format\": \"zeroset-reference\"").unwrap();
     let error = Reference::load(&path).unwrap_err();
     assert!(matches!(error, ReferenceFileError::Parse { .. }), "{error}");
@@ -129,7 +136,7 @@ fn nominals_start_and_end_at_the_scan_and_stay_within_the_spacing() {
         for pair in nominals.windows(2) {
             let step = (Vector3::from(pair[1].point) - Vector3::from(pair[0].point)).norm();
             assert!(
-                step <= SETTINGS.nominal_spacing_mm,
+                step <= SETTINGS.nominal_spacing_mm(),
                 "{step} mm between {pair:?}"
             );
         }
@@ -199,9 +206,10 @@ fn teaching_refuses_what_cannot_make_a_reference() {
         teach("p", &same_plane, &SETTINGS).unwrap_err(),
         TeachError::Stack(StackError::SamePosition(..))
     ));
-    let no_spacing = ReferenceSettings {
+    let no_spacing = ReferenceSettings::ImplicitPolynomial {
+        degree: 4,
+        method: FitMethod::Orthogonal,
         nominal_spacing_mm: 0.0,
-        ..SETTINGS
     };
     assert!(matches!(
         teach("p", &profiles, &no_spacing).unwrap_err(),

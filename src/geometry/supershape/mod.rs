@@ -12,5 +12,6 @@ pub mod csg;
 pub mod deform;
 pub mod distance;
 pub mod formula;
+pub mod prism;
 pub mod rfunc;
 pub mod shape;

@@ -2,7 +2,6 @@ use quick_xml::events::Event;
 
 use super::*;
 use crate::analysis::stats::RunningStats;
-use crate::geometry::fit3l::FitMethod;
 use crate::report::{
     InstanceReport, MachineUse, PointRecord, ReferenceUse, FORMAT, UNITS, VERSION,
 };
@@ -123,8 +122,7 @@ fn propeller(instances: Vec<InstanceReport>) -> PartReport {
         reference: ReferenceUse {
             path: "data/references/propeller.json".to_string(),
             taught_at: "2025-03-01T08:00:00Z".to_string(),
-            method: FitMethod::ThreeL,
-            degree: 4,
+            model: "implicit polynomial of degree 4 per profile".to_string(),
         },
         distance: "exact orthogonal distance".to_string(),
         compensation: "ball radius along the normal".to_string(),

@@ -7,7 +7,6 @@ use quick_xml::Reader;
 
 use super::*;
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
-use crate::geometry::fit3l::FitMethod;
 use crate::report::{
     InstanceReport, MachineUse, PointRecord, ProfileReport, ReferenceUse, FORMAT, UNITS, VERSION,
 };
@@ -137,8 +136,7 @@ fn two_blade_report() -> PartReport {
         reference: ReferenceUse {
             path: "/var/lib/zeroset/references/propeller-2.json".to_string(),
             taught_at: "2025-03-01T08:00:00Z".to_string(),
-            method: FitMethod::Orthogonal,
-            degree: 4,
+            model: "implicit polynomial of degree 4 per profile".to_string(),
         },
         distance: "exact orthogonal distance to each profile's 2-D IP".to_string(),
         compensation: "ball radius along the reported normal".to_string(),
