@@ -65,7 +65,8 @@ impl BallSweep<'_> {
 
     /// Body-frame eye, p(t) = R(t)^T (P - c(t)).
     pub fn body_eye(&self, t: f64) -> Option<Vector3<f64>> {
-        self.eye.map(|eye| self.motion.pose(t).inverse_transform_point(&eye).coords)
+        self.eye
+            .map(|eye| self.motion.pose(t).inverse_transform_point(&eye).coords)
     }
 
     /// F of eq. (1) and its gradient.

@@ -83,7 +83,9 @@ impl ArcSweptBall {
     }
 
     pub fn ball_centre(&self, t: f64) -> Point3<f64> {
-        self.centre + self.axis.into_inner() * self.height() + self.radial(t) * self.path_radius_mm()
+        self.centre
+            + self.axis.into_inner() * self.height()
+            + self.radial(t) * self.path_radius_mm()
     }
 
     /// Unit direction of travel of the ball centre at time t.
@@ -101,7 +103,10 @@ impl ArcSweptBall {
         let e1 = self.radial(0.0);
         let e2 = self.axis.cross(&e1) * self.angle_rad.signum();
         // Angle of p about the axis, measured in the arc's direction of travel, in [0, 2 pi).
-        let phi = in_plane.dot(&e2).atan2(in_plane.dot(&e1)).rem_euclid(std::f64::consts::TAU);
+        let phi = in_plane
+            .dot(&e2)
+            .atan2(in_plane.dot(&e1))
+            .rem_euclid(std::f64::consts::TAU);
         if rho > 0.0 && phi <= self.angle_rad.abs() {
             ((rho - big_r).powi(2) + h * h).sqrt()
         } else {
@@ -134,7 +139,10 @@ impl ArcSweptBall {
     pub fn volume(&self) -> Option<f64> {
         let r = self.ball_radius_mm;
         self.is_simple().then(|| {
-            std::f64::consts::PI * r * r * (self.path_radius_mm() * self.angle_rad.abs() + 4.0 / 3.0 * r)
+            std::f64::consts::PI
+                * r
+                * r
+                * (self.path_radius_mm() * self.angle_rad.abs() + 4.0 / 3.0 * r)
         })
     }
 

@@ -78,7 +78,10 @@ impl PseudoNormals {
         let mut face = Vec::with_capacity(triangles.len());
         for tri in triangles {
             let p = tri.map(|i| vertices[i]);
-            let n = (p[1] - p[0]).cross(&(p[2] - p[0])).try_normalize(0.0).unwrap_or_default();
+            let n = (p[1] - p[0])
+                .cross(&(p[2] - p[0]))
+                .try_normalize(0.0)
+                .unwrap_or_default();
             face.push(n);
             for k in 0..3 {
                 let e = edge.entry(edge_key(tri[k], tri[(k + 1) % 3])).or_default();

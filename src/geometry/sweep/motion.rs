@@ -168,9 +168,10 @@ impl Motion {
     /// The rigid map from body coordinates to the part's frame at time t.
     pub fn pose(&self, t: f64) -> Isometry3<f64> {
         match self {
-            Self::Line { from, to } => {
-                Isometry3::from_parts(Translation3::from(from.lerp(to, t).coords), UnitQuaternion::identity())
-            }
+            Self::Line { from, to } => Isometry3::from_parts(
+                Translation3::from(from.lerp(to, t).coords),
+                UnitQuaternion::identity(),
+            ),
             Self::Arc {
                 centre,
                 axis,

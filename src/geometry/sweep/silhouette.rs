@@ -101,7 +101,9 @@ pub fn ball_silhouette(
                 .iter()
                 .all(|c| distance_to_curve(&sweep, c, &seed) > step_mm)
             {
-                curves.push(trace_through(&sweep, &system, seed, step_mm, max_steps, scale));
+                curves.push(trace_through(
+                    &sweep, &system, seed, step_mm, max_steps, scale,
+                ));
             }
         }
     }
@@ -110,7 +112,10 @@ pub fn ball_silhouette(
         .into_iter()
         .map(|c| {
             let extremes = t_extremes(&sweep, &system, &c, scale);
-            (piece(&sweep, PieceKind::Envelope, c.points, c.closed), extremes)
+            (
+                piece(&sweep, PieceKind::Envelope, c.points, c.closed),
+                extremes,
+            )
         })
         .collect();
     for (t, kind) in [(0.0, PieceKind::StartCap), (1.0, PieceKind::EndCap)] {
@@ -121,7 +126,12 @@ pub fn ball_silhouette(
     Ok(components(pieces))
 }
 
-fn piece(sweep: &BallSweep<'_>, kind: PieceKind, params: Vec<SurfaceTime>, closed: bool) -> SilhouettePiece {
+fn piece(
+    sweep: &BallSweep<'_>,
+    kind: PieceKind,
+    params: Vec<SurfaceTime>,
+    closed: bool,
+) -> SilhouettePiece {
     let points = params.iter().map(|q| sweep.world_point(q)).collect();
     SilhouettePiece {
         kind,
@@ -132,11 +142,7 @@ fn piece(sweep: &BallSweep<'_>, kind: PieceKind, params: Vec<SurfaceTime>, close
 }
 
 /// Solutions of F = G = 0 at a fixed t: Newton from the 26 directions of a cube's faces, edges and corners.
-fn seeds_at(
-    system: &SilhouetteSystem<'_>,
-    t: f64,
-    scale: f64,
-) -> Vec<SurfaceTime> {
+fn seeds_at(system: &SilhouetteSystem<'_>, t: f64, scale: f64) -> Vec<SurfaceTime> {
     let mut found: Vec<SurfaceTime> = Vec::new();
     for i in -1..=1 {
         for j in -1..=1 {
@@ -184,7 +190,10 @@ fn t_extremes(
             continue;
         }
         if let Some(q) = refine_t_extreme(sweep, system, b, scale) {
-            if out.iter().all(|e| (e.param.normal() - q.normal()).norm() + (e.param.t - q.t).abs() > 1e-6) {
+            if out
+                .iter()
+                .all(|e| (e.param.normal() - q.normal()).norm() + (e.param.t - q.t).abs() > 1e-6)
+            {
                 out.push(TExtreme {
                     param: q,
                     point: sweep.world_point(&q),
@@ -211,9 +220,15 @@ fn refine_t_extreme(
         for k in 0..3 {
             let mut e = Vector3::zeros();
             e[k] = H;
-            grad_h[k] = (sweep.t_extremality(&q.shifted(&e)) - sweep.t_extremality(&q.shifted(&-e))) / (2.0 * H);
+            grad_h[k] = (sweep.t_extremality(&q.shifted(&e))
+                - sweep.t_extremality(&q.shifted(&-e)))
+                / (2.0 * H);
         }
-        let m = Matrix3::from_rows(&[j.row(0).into_owned(), j.row(1).into_owned(), grad_h.transpose()]);
+        let m = Matrix3::from_rows(&[
+            j.row(0).into_owned(),
+            j.row(1).into_owned(),
+            grad_h.transpose(),
+        ]);
         let delta = m.lu().solve(&Vector3::new(fg.x, fg.y, h))?;
         q = q.shifted(&-delta);
         q.s = q.s.rechart();
@@ -235,7 +250,10 @@ fn cap_arcs(sweep: &BallSweep<'_>, t: f64, step_mm: f64) -> Vec<(Vec<SurfaceTime
     let dist = p.norm();
     let axis = p / dist;
     let (cos_a, sin_a) = (r / dist, (1.0 - (r / dist).powi(2)).sqrt());
-    let e1 = axis.cross(&Vector3::x()).try_normalize(1e-6).unwrap_or_else(|| axis.cross(&Vector3::y()).normalize());
+    let e1 = axis
+        .cross(&Vector3::x())
+        .try_normalize(1e-6)
+        .unwrap_or_else(|| axis.cross(&Vector3::y()).normalize());
     let e2 = axis.cross(&e1);
     let normal_at = |beta: f64| axis * cos_a + (e1 * beta.cos() + e2 * beta.sin()) * sin_a;
     // sigma <w, n(beta)> = a + b cos(beta) + c sin(beta)
@@ -259,7 +277,9 @@ fn cap_arcs(sweep: &BallSweep<'_>, t: f64, step_mm: f64) -> Vec<(Vec<SurfaceTime
             let last = if full { count - 1 } else { count };
             let arc = (0..=last)
                 .map(|i| SurfaceTime {
-                    s: SpherePoint::from_normal(&normal_at(lo + (hi - lo) * i as f64 / count as f64)),
+                    s: SpherePoint::from_normal(&normal_at(
+                        lo + (hi - lo) * i as f64 / count as f64,
+                    )),
                     t,
                 })
                 .collect();
@@ -288,9 +308,11 @@ fn components(pieces: Vec<(SilhouettePiece, Vec<TExtreme>)>) -> Vec<SilhouetteCo
     };
     for i in 0..n {
         for j in i + 1..n {
-            let touch = ends(&pieces[i].0)
-                .iter()
-                .any(|a| ends(&pieces[j].0).iter().any(|b| (a - b).norm() < JOIN_TOLERANCE_MM));
+            let touch = ends(&pieces[i].0).iter().any(|a| {
+                ends(&pieces[j].0)
+                    .iter()
+                    .any(|b| (a - b).norm() < JOIN_TOLERANCE_MM)
+            });
             if touch {
                 let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
                 parent[ri] = rj;
@@ -348,7 +370,8 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
             c.pieces
                 .iter()
                 .map(|p| {
-                    let mut pts: Vec<(f64, f64)> = p.points.iter().filter_map(|x| view.project(x)).collect();
+                    let mut pts: Vec<(f64, f64)> =
+                        p.points.iter().filter_map(|x| view.project(x)).collect();
                     if p.closed && !pts.is_empty() {
                         pts.push(pts[0]);
                     }
@@ -358,7 +381,10 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
         })
         .collect();
     let all = projected.iter().flatten().flat_map(|(_, pts)| pts.iter());
-    let (mut lo, mut hi) = ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        (f64::INFINITY, f64::INFINITY),
+        (f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
     for &(x, y) in all {
         lo = (lo.0.min(x), lo.1.min(y));
         hi = (hi.0.max(x), hi.1.max(y));
@@ -370,14 +396,31 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{size_px}\" height=\"{size_px}\" viewBox=\"0 0 {size_px} {size_px}\">\n"
     );
     for (i, component) in projected.iter().enumerate() {
-        let _ = writeln!(svg, "<g id=\"component-{i}\" fill=\"none\" stroke-width=\"1\">");
+        let _ = writeln!(
+            svg,
+            "<g id=\"component-{i}\" fill=\"none\" stroke-width=\"1\">"
+        );
         for (kind, pts) in component {
-            let stroke = if *kind == PieceKind::Envelope { "black" } else { "grey" };
+            let stroke = if *kind == PieceKind::Envelope {
+                "black"
+            } else {
+                "grey"
+            };
             let coords: Vec<String> = pts
                 .iter()
-                .map(|(x, y)| format!("{:.3},{:.3}", margin + (x - lo.0) * scale, size_px - margin - (y - lo.1) * scale))
+                .map(|(x, y)| {
+                    format!(
+                        "{:.3},{:.3}",
+                        margin + (x - lo.0) * scale,
+                        size_px - margin - (y - lo.1) * scale
+                    )
+                })
                 .collect();
-            let _ = writeln!(svg, "<polyline stroke=\"{stroke}\" points=\"{}\"/>", coords.join(" "));
+            let _ = writeln!(
+                svg,
+                "<polyline stroke=\"{stroke}\" points=\"{}\"/>",
+                coords.join(" ")
+            );
         }
         svg.push_str("</g>\n");
     }
@@ -402,9 +445,24 @@ pub fn traced_characteristic(
     };
     let system = CharacteristicAt { sweep: &sweep, t };
     let scale = sweep.speed_bound().max(1.0);
-    let seed = [Vector3::x(), Vector3::y(), Vector3::z(), Vector3::new(1.0, 1.0, 1.0)]
-        .iter()
-        .find_map(|d| correct(&system, SurfaceTime { s: SpherePoint::from_normal(d), t }, false, scale))?;
+    let seed = [
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::z(),
+        Vector3::new(1.0, 1.0, 1.0),
+    ]
+    .iter()
+    .find_map(|d| {
+        correct(
+            &system,
+            SurfaceTime {
+                s: SpherePoint::from_normal(d),
+                t,
+            },
+            false,
+            scale,
+        )
+    })?;
     let max_steps = (10.0 * TAU * radius_mm / step_mm) as usize + 100;
     let curve = trace_through(&sweep, &system, seed, step_mm, max_steps, scale);
     let points = curve.points.iter().map(|q| sweep.world_point(q)).collect();

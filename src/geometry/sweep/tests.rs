@@ -70,19 +70,36 @@ fn sweep_capsule_point_and_segment_distances_match_closed_forms() {
     close(cap.point_distance(&p(13.0, 4.0, 0.0)), 3.0);
     close(cap.point_distance(&p(-3.0, 0.0, 0.0)), 1.0);
     close(cap.point_distance(&p(5.0, 1.0, 0.0)), -1.0);
-    close(cap.segment_distance(&p(2.0, 0.0, 7.0), &p(8.0, 0.0, 7.0)), 5.0);
-    close(cap.segment_distance(&p(4.0, -5.0, 6.0), &p(4.0, 5.0, 6.0)), 4.0);
-    close(cap.segment_distance(&p(4.0, -5.0, 0.0), &p(4.0, 5.0, 0.0)), -2.0);
-    close(cap.segment_distance(&p(12.0, 0.0, 0.0), &p(20.0, 0.0, 0.0)), 0.0);
+    close(
+        cap.segment_distance(&p(2.0, 0.0, 7.0), &p(8.0, 0.0, 7.0)),
+        5.0,
+    );
+    close(
+        cap.segment_distance(&p(4.0, -5.0, 6.0), &p(4.0, 5.0, 6.0)),
+        4.0,
+    );
+    close(
+        cap.segment_distance(&p(4.0, -5.0, 0.0), &p(4.0, 5.0, 0.0)),
+        -2.0,
+    );
+    close(
+        cap.segment_distance(&p(12.0, 0.0, 0.0), &p(20.0, 0.0, 0.0)),
+        0.0,
+    );
     // Skew segment whose closest point is an end of both: (13, 3, 4) to b = (10, 0, 0): sqrt(34).
-    close(cap.segment_distance(&p(13.0, 3.0, 4.0), &p(20.0, 9.0, 9.0)), 34f64.sqrt() - 2.0);
+    close(
+        cap.segment_distance(&p(13.0, 3.0, 4.0), &p(20.0, 9.0, 9.0)),
+        34f64.sqrt() - 2.0,
+    );
     close(cap.volume(), PI * 4.0 * (10.0 + 8.0 / 3.0));
 
     // Random segments against a dense sampling: the exact distance is never above the sampled minimum and at
     // most the sampling's half spacing below it.
     let mut seed = 7u64;
     let mut rand = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (seed >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 5.0
     };
     for _ in 0..50 {
@@ -94,7 +111,10 @@ fn sweep_capsule_point_and_segment_distances_match_closed_forms() {
             .fold(f64::INFINITY, f64::min);
         let half_spacing = 0.5 * (b - a).norm() / samples as f64;
         if sampled > 0.0 {
-            assert!(exact <= sampled + 1e-12 && exact >= sampled - half_spacing, "{exact} vs {sampled}");
+            assert!(
+                exact <= sampled + 1e-12 && exact >= sampled - half_spacing,
+                "{exact} vs {sampled}"
+            );
         } else {
             assert!(exact <= 0.0);
         }
@@ -103,7 +123,11 @@ fn sweep_capsule_point_and_segment_distances_match_closed_forms() {
 
 #[test]
 fn sweep_mesh_distances_are_exact_and_signed() {
-    let cube = prism(&[(45.0, -5.0), (55.0, -5.0), (55.0, 5.0), (45.0, 5.0)], -5.0, 5.0);
+    let cube = prism(
+        &[(45.0, -5.0), (55.0, -5.0), (55.0, 5.0), (45.0, 5.0)],
+        -5.0,
+        5.0,
+    );
     assert!(cube.is_signed());
     let close = |a: f64, b: f64| assert!((a - b).abs() < 1e-12, "{a} vs {b}");
     close(cube.distance(&p(50.0, 0.0, 8.0)), 3.0);
@@ -113,9 +137,15 @@ fn sweep_mesh_distances_are_exact_and_signed() {
     close(cube.distance(&p(46.0, 4.5, 4.0)), -0.5);
     let through = cube.segment_proximity(&p(40.0, 0.0, 0.0), &p(60.0, 0.0, 0.0));
     assert!(through.distance_mm.abs() < 1e-12);
-    close(cube.segment_proximity(&p(48.0, 0.0, 0.0), &p(52.0, 1.0, 1.0)).distance_mm, -3.0);
+    close(
+        cube.segment_proximity(&p(48.0, 0.0, 0.0), &p(52.0, 1.0, 1.0))
+            .distance_mm,
+        -3.0,
+    );
     let above = cube.segment_proximity(&p(40.0, 0.0, 7.0), &p(60.0, 0.0, 9.0));
-    close(above.distance_mm, (45.0 - 40.0) / 20.0 * 2.0 + 2.0);
+    // Nearest to the top edge x = 45, z = 5: the distance between the two lines, 2.5 / sqrt(1.01).
+    close(above.distance_mm, 2.5 / 1.01f64.sqrt());
+    close(above.part_point.x, 45.0);
     close(above.part_point.z, 5.0);
     // An open mesh (the cube without its top) is unsigned.
     let open = MeshPart::new(
@@ -142,9 +172,21 @@ fn sweep_motions_twist_and_speed_bound_agree_with_the_pose() {
     assert!((reach - 52.0).abs() < 1e-12);
     let motions = [
         Motion::line(p(1.0, 2.0, 3.0), p(-20.0, 7.0, 40.0)),
-        Motion::arc(p(5.0, 5.0, 0.0), Vector3::new(0.3, -0.2, 1.0), p(30.0, 5.0, 2.0), -2.5).unwrap(),
+        Motion::arc(
+            p(5.0, 5.0, 0.0),
+            Vector3::new(0.3, -0.2, 1.0),
+            p(30.0, 5.0, 2.0),
+            -2.5,
+        )
+        .unwrap(),
         Motion::rotary_index(p(100.0, 50.0, 0.0), p(60.0, 20.0, 40.0), 0.3, 1.9),
-        Motion::Scan(ScanPath::new(vec![p(0.0, 0.0, 0.0), p(10.0, 0.0, 0.0), p(10.0, 5.0, 2.0)], false).unwrap()),
+        Motion::Scan(
+            ScanPath::new(
+                vec![p(0.0, 0.0, 0.0), p(10.0, 0.0, 0.0), p(10.0, 5.0, 2.0)],
+                false,
+            )
+            .unwrap(),
+        ),
     ];
     let body_points: Vec<Point3<f64>> = stylus
         .capsules()
@@ -163,8 +205,15 @@ fn sweep_motions_twist_and_speed_bound_agree_with_the_pose() {
             for x in &body_points {
                 let fd = (motion.pose(t + h) * x - motion.pose(t - h) * x) / (2.0 * h);
                 let v = twist.point_velocity(&motion.centre(t), &(pose * x));
-                assert!((fd - v).norm() < 1e-6 * (1.0 + v.norm()), "{motion:?} t={t}: {fd} vs {v}");
-                assert!(v.norm() <= bound * (1.0 + 1e-12), "{motion:?}: speed {} > {bound}", v.norm());
+                assert!(
+                    (fd - v).norm() < 1e-6 * (1.0 + v.norm()),
+                    "{motion:?} t={t}: {fd} vs {v}"
+                );
+                assert!(
+                    v.norm() <= bound * (1.0 + 1e-12),
+                    "{motion:?}: speed {} > {bound}",
+                    v.norm()
+                );
             }
         }
     }
@@ -200,12 +249,20 @@ fn sweep_arc_envelope_volume_and_surface_residuals() {
             volume += tube.point.coords.dot(&tube.normal) * tube.area_density * 0.5 * wx * w_around;
             for end in [End::Start, End::End] {
                 let cap = sweep.cap_sample(end, FRAC_PI_2 * 0.5 * (x + 1.0), angle);
-                volume += cap.point.coords.dot(&cap.normal) * cap.area_density * FRAC_PI_2 * 0.5 * wx * w_around;
+                volume += cap.point.coords.dot(&cap.normal)
+                    * cap.area_density
+                    * FRAC_PI_2
+                    * 0.5
+                    * wx
+                    * w_around;
             }
         }
     }
     volume /= 3.0;
-    assert!((volume - pappus).abs() < 1e-9 * pappus, "{volume} vs {pappus}");
+    assert!(
+        (volume - pappus).abs() < 1e-9 * pappus,
+        "{volume} vs {pappus}"
+    );
 
     // Every envelope point is exactly r from the centre path, and on the tube its normal is perpendicular to the
     // direction of travel (F = 0).
@@ -233,7 +290,11 @@ fn sweep_arc_envelope_volume_and_surface_residuals() {
 
 /// A 0.3 mm trailing edge: a wedge tapering from 3 mm to 0.3 mm over 20 mm, 10 mm tall.
 fn trailing_edge() -> MeshPart {
-    prism(&[(0.0, -1.5), (20.0, -0.15), (20.0, 0.15), (0.0, 1.5)], 0.0, 10.0)
+    prism(
+        &[(0.0, -1.5), (20.0, -0.15), (20.0, 0.15), (0.0, 1.5)],
+        0.0,
+        10.0,
+    )
 }
 
 #[test]
@@ -257,9 +318,16 @@ fn sweep_clearance_catches_a_clipped_trailing_edge_that_sampling_misses() {
     // First contact: the ball meets the edge (x = 20, y = -0.15) when its centre is 1 mm from it.
     let y_star = -0.15 - (1.0 - (1.0 - depth) * (1.0 - depth)).sqrt();
     let t_star = (y_star - y0) / (y1 - y0);
-    assert!(contact >= t_star - 1e-12 && contact - t_star <= RESOLUTION_MM / 10.0 + 1e-12, "{contact} vs {t_star}");
+    assert!(
+        contact >= t_star - 1e-12 && contact - t_star <= RESOLUTION_MM / 10.0 + 1e-12,
+        "{contact} vs {t_star}"
+    );
     assert_eq!(c.stylus_part, "ball");
-    assert!((c.at_point - p(20.0, -0.15, 5.0)).norm() < 1e-3, "{}", c.at_point);
+    assert!(
+        (c.at_point - p(20.0, -0.15, 5.0)).norm() < 1e-3,
+        "{}",
+        c.at_point
+    );
 
     // In a plan with a margin, the move is refused with where and by how much.
     let approach = Motion::line(p(x, -30.0, 5.0), p(x, y0, 5.0));
@@ -273,25 +341,36 @@ fn sweep_clearance_catches_a_clipped_trailing_edge_that_sampling_misses() {
     let pass = Motion::line(p(21.2, y0, 5.0), p(21.2, y1, 5.0));
     let plan = check_plan(&stylus, &[approach, pass], &wedge, 0.05).unwrap();
     assert_eq!(plan.closest_move, 1);
-    assert!((plan.min_distance_mm - 0.2).abs() < 1e-9, "{}", plan.min_distance_mm);
+    assert!(
+        (plan.min_distance_mm - 0.2).abs() < 1e-9,
+        "{}",
+        plan.min_distance_mm
+    );
     assert!(plan.moves[1].lower_bound_mm >= 0.05 - 0.5 * RESOLUTION_MM);
     assert!(plan.moves[1].first_contact_t.is_none());
 }
 
 #[test]
 fn sweep_clearance_of_a_rotary_index_finds_the_contact_angle() {
-    let cube = prism(&[(45.0, -5.0), (55.0, -5.0), (55.0, 5.0), (45.0, 5.0)], -5.0, 5.0);
+    let cube = prism(
+        &[(45.0, -5.0), (55.0, -5.0), (55.0, 5.0), (45.0, 5.0)],
+        -5.0,
+        5.0,
+    );
     let stylus = Stylus::new(1.0, 0.4, 30.0).unwrap();
     let index = Motion::rotary_index(p(0.0, 0.0, 0.0), p(0.0, 50.0, 5.0), 0.0, FRAC_PI_2);
     let c = check_move(&stylus, &index, &cube, 0.0);
     // Relative to the part the ball centre is (50 sin a, 50 cos a, 5): it meets the cube's top edge y = 5,
     // z = 5 when 50 cos a - 5 = 1.
     let t_star = (6.0f64 / 50.0).acos() / FRAC_PI_2;
-    let contact = c.first_contact_t.expect("the index swings the part into the stylus");
+    let contact = c
+        .first_contact_t
+        .expect("the index swings the part into the stylus");
     let speed = index.max_point_speed(stylus.reach_mm());
     assert!(contact >= t_star - 1e-12 && contact - t_star <= RESOLUTION_MM / speed + 1e-12);
     // A contact scan along the top face ignores the ball but watches the shank.
-    let scan = Motion::Scan(ScanPath::new(vec![p(46.0, 0.0, 6.0), p(54.0, 0.0, 6.0)], true).unwrap());
+    let scan =
+        Motion::Scan(ScanPath::new(vec![p(46.0, 0.0, 6.0), p(54.0, 0.0, 6.0)], true).unwrap());
     let scanned = check_move(&stylus, &scan, &cube, 0.0);
     assert_eq!(scanned.stylus_part, "shank");
     assert!((scanned.min_distance_mm - 0.6).abs() < 1e-12);
@@ -316,7 +395,11 @@ fn sweep_traced_characteristic_curves_are_the_closed_form_circles() {
             let direction = motion.twist(t).centre_velocity.normalize();
             for x in &points {
                 assert!(((x - centre).norm() - r).abs() < 1e-12);
-                assert!((x - centre).dot(&direction).abs() < 1e-12, "{}", (x - centre).dot(&direction));
+                assert!(
+                    (x - centre).dot(&direction).abs() < 1e-12,
+                    "{}",
+                    (x - centre).dot(&direction)
+                );
             }
             // The traced polygon follows the whole circle: every closed-form point is within the chord's sagitta.
             let sagitta = 2.0 * step * step / (8.0 * r);
@@ -335,7 +418,9 @@ fn sweep_traced_characteristic_curves_are_the_closed_form_circles() {
                 assert!(nearest <= sagitta, "{nearest} > {sagitta}");
             }
             if motion == &motions[0] {
-                assert!(params.iter().any(|q| q.s.chart == 0) && params.iter().any(|q| q.s.chart == 1));
+                assert!(
+                    params.iter().any(|q| q.s.chart == 0) && params.iter().any(|q| q.s.chart == 1)
+                );
             }
         }
     }
@@ -343,7 +428,12 @@ fn sweep_traced_characteristic_curves_are_the_closed_form_circles() {
 
 #[test]
 fn sweep_sphere_charts_agree_and_stay_away_from_poles() {
-    for n in [Vector3::z(), -Vector3::x(), Vector3::new(0.3, -0.4, 0.8), Vector3::new(-1.0, 1.0, 1e-3)] {
+    for n in [
+        Vector3::z(),
+        -Vector3::x(),
+        Vector3::new(0.3, -0.4, 0.8),
+        Vector3::new(-1.0, 1.0, 1e-3),
+    ] {
         let s = SpherePoint::from_normal(&n);
         assert!(s.v.abs() <= FRAC_PI_2 / 2.0 + 1e-12);
         assert!((s.normal() - n.normalize()).norm() < 1e-15);
@@ -354,7 +444,12 @@ fn sweep_sphere_charts_agree_and_stay_away_from_poles() {
 }
 
 /// Residuals of eqs. (1) and (2) at every point of every envelope piece.
-fn assert_on_silhouette(motion: &Motion, r: f64, eye: Point3<f64>, components: &[super::silhouette::SilhouetteComponent]) {
+fn assert_on_silhouette(
+    motion: &Motion,
+    r: f64,
+    eye: Point3<f64>,
+    components: &[super::silhouette::SilhouetteComponent],
+) {
     let sweep = super::ball_system::BallSweep {
         motion,
         radius_mm: r,
@@ -382,12 +477,22 @@ fn sweep_silhouette_of_a_ball_on_a_line_is_the_capsule_outline() {
     // One closed outline: two envelope lines joined by an arc on each cap.
     assert_eq!(components.len(), 1);
     let kinds: Vec<PieceKind> = components[0].pieces.iter().map(|p| p.kind).collect();
-    assert_eq!(kinds.iter().filter(|&&k| k == PieceKind::Envelope).count(), 2);
-    assert_eq!(kinds.iter().filter(|&&k| k == PieceKind::StartCap).count(), 1);
+    assert_eq!(
+        kinds.iter().filter(|&&k| k == PieceKind::Envelope).count(),
+        2
+    );
+    assert_eq!(
+        kinds.iter().filter(|&&k| k == PieceKind::StartCap).count(),
+        1
+    );
     assert_eq!(kinds.iter().filter(|&&k| k == PieceKind::EndCap).count(), 1);
     assert!(components[0].t_extremes.is_empty());
     // The envelope lines are the capsule's contour generators: straight, parallel to the axis, spanning it.
-    for piece in components[0].pieces.iter().filter(|p| p.kind == PieceKind::Envelope) {
+    for piece in components[0]
+        .pieces
+        .iter()
+        .filter(|p| p.kind == PieceKind::Envelope)
+    {
         let (first, last) = (piece.points[0], piece.points[piece.points.len() - 1]);
         assert!(((last - first).x.abs() - 40.0).abs() < 1e-9);
         assert!((last - first).yz().norm() < 1e-9);
@@ -443,7 +548,15 @@ fn sweep_silhouette_of_a_ball_on_an_arc_has_a_t_extreme_point() {
             hi = mid;
         }
     }
-    assert!((extremes[0].param.t - lo).abs() < 1e-9, "{} vs {lo}", extremes[0].param.t);
-    let kinds = |c: &super::silhouette::SilhouetteComponent| c.pieces.iter().map(|p| p.kind).collect::<Vec<_>>();
-    assert!(components.iter().any(|c| kinds(c) == vec![PieceKind::StartCap]));
+    assert!(
+        (extremes[0].param.t - lo).abs() < 1e-9,
+        "{} vs {lo}",
+        extremes[0].param.t
+    );
+    let kinds = |c: &super::silhouette::SilhouetteComponent| {
+        c.pieces.iter().map(|p| p.kind).collect::<Vec<_>>()
+    };
+    assert!(components
+        .iter()
+        .any(|c| kinds(c) == vec![PieceKind::StartCap]));
 }

@@ -13,6 +13,10 @@ const NEWTON_STEP_TOL: f64 = 1e-15;
 /// A corrected point must satisfy the equations to this (relative to their scale) or it is rejected.
 const ACCEPT_RESIDUAL: f64 = 1e-10;
 
+/// Newton's updates can move t off a bound it should stay on by rounding (a curve at fixed t = 0 or 1); such
+/// excursions are clamped rather than taken for the curve leaving the domain.
+const T_ROUNDING: f64 = 1e-12;
+
 /// A traced curve: its points in surface-time space, and whether it closed on itself.
 #[derive(Debug, Clone)]
 pub struct TracedCurve {
@@ -118,7 +122,10 @@ pub fn trace(
                 break None;
             }
         };
-        let Some(next) = next else { break };
+        let Some(mut next) = next else { break };
+        if (next.t - next.t.clamp(0.0, 1.0)).abs() <= T_ROUNDING {
+            next.t = next.t.clamp(0.0, 1.0);
+        }
         if next.t < 0.0 || next.t > 1.0 {
             let bound = next.t.clamp(0.0, 1.0);
             let mut clipped = next;
@@ -134,6 +141,10 @@ pub fn trace(
             };
         }
         if points.len() > 3 && distance(sweep, &next, &start) < 0.75 * step_mm {
+            // Keep the last point unless it nearly repeats the first, so that no chord exceeds a step.
+            if distance(sweep, &next, &start) > 0.25 * step_mm {
+                points.push(next);
+            }
             return TracedCurve {
                 points,
                 closed: true,
