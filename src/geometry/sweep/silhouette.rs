@@ -78,7 +78,7 @@ pub fn ball_silhouette(
     if !motion.is_smooth() {
         return Err(SilhouetteError::NotSmooth);
     }
-    if !(step_mm > 0.0) {
+    if step_mm.is_nan() || step_mm <= 0.0 {
         return Err(SilhouetteError::BadStep(step_mm));
     }
     let sweep = BallSweep {
@@ -361,10 +361,13 @@ impl View {
     }
 }
 
+/// A piece's kind and its points on the image plane.
+type ProjectedPiece = (PieceKind, Vec<(f64, f64)>);
+
 /// The components as an SVG document of `size_px` square: one group per component, one polyline per piece
 /// (envelope pieces black, cap pieces grey).
 pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: f64) -> String {
-    let projected: Vec<Vec<(PieceKind, Vec<(f64, f64)>)>> = components
+    let projected: Vec<Vec<ProjectedPiece>> = components
         .iter()
         .map(|c| {
             c.pieces
@@ -428,6 +431,14 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
     svg
 }
 
+/// A traced characteristic curve: surface-time parameters, points in the part's frame, whether it closed.
+#[derive(Debug, Clone)]
+pub struct CharacteristicCurve {
+    pub params: Vec<SurfaceTime>,
+    pub points: Vec<Point3<f64>>,
+    pub closed: bool,
+}
+
 /// The characteristic curve K^t of the ball at time t (F = 0 at fixed t), traced numerically from a seed found by
 /// Newton's method, as points in the part's frame. The closed form is the great circle perpendicular to the
 /// centre's velocity ([`super::envelope`]); this general tracer is what a body without a closed form would use.
@@ -436,7 +447,7 @@ pub fn traced_characteristic(
     radius_mm: f64,
     t: f64,
     step_mm: f64,
-) -> Option<(Vec<SurfaceTime>, Vec<Point3<f64>>, bool)> {
+) -> Option<CharacteristicCurve> {
     use super::ball_system::CharacteristicAt;
     let sweep = BallSweep {
         motion,
@@ -466,5 +477,9 @@ pub fn traced_characteristic(
     let max_steps = (10.0 * TAU * radius_mm / step_mm) as usize + 100;
     let curve = trace_through(&sweep, &system, seed, step_mm, max_steps, scale);
     let points = curve.points.iter().map(|q| sweep.world_point(q)).collect();
-    Some((curve.points, points, curve.closed))
+    Some(CharacteristicCurve {
+        params: curve.points,
+        points,
+        closed: curve.closed,
+    })
 }

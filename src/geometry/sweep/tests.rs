@@ -389,7 +389,8 @@ fn sweep_traced_characteristic_curves_are_the_closed_form_circles() {
     ];
     for motion in &motions {
         for t in [0.0, 0.37, 1.0] {
-            let (params, points, closed) = traced_characteristic(motion, r, t, step).unwrap();
+            let curve = traced_characteristic(motion, r, t, step).unwrap();
+            let (params, points, closed) = (curve.params, curve.points, curve.closed);
             assert!(closed, "{motion:?} at t = {t} did not close");
             let centre = motion.centre(t);
             let direction = motion.twist(t).centre_velocity.normalize();
