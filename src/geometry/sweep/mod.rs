@@ -1,0 +1,19 @@
+//! The stylus's swept volume along planned moves (issue 6), after Seong, Kim, Kim and Elber, "Perspective
+//! silhouette of a general swept volume" (seed 002): the stylus as a moving rigid body, the envelope of its ball
+//! (closed forms, and the characteristic curves traced numerically), the clearance of a planned move against the
+//! part's model by conservative advancement, and the perspective silhouette of the swept ball.
+
+pub mod ball_system;
+pub mod charts;
+pub mod clearance;
+pub mod closest;
+pub mod envelope;
+pub mod mesh;
+pub mod motion;
+pub mod part;
+pub mod silhouette;
+pub mod stylus;
+pub mod tracer;
+
+#[cfg(test)]
+mod tests;
