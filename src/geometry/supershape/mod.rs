@@ -11,5 +11,6 @@
 pub mod csg;
 pub mod deform;
 pub mod formula;
+pub mod mesh;
 pub mod rfunc;
 pub mod shape;
