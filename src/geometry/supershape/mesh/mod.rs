@@ -139,7 +139,8 @@ mod tests {
     const BORE: f64 = 6.0;
 
     /// A twisted hexagonal prism with a through bore (a nut), united with a scaled, tapered,
-    /// bent lobed shape on its side; the whole turned and moved. Genus 1.
+    /// bent five-lobed shape on its side (lobes reaching 6 to 14.3 mm from its axis, one of them
+    /// well into the nut, the others clear of it); the whole turned and moved. Genus 1.
     fn nut_with_lobe() -> Solid {
         let hexagon = Supershape {
             r1: Superformula::new(6.0, 8.0, 4.0, 4.0, 1.0, 1.0).unwrap(),
@@ -173,7 +174,7 @@ mod tests {
                     ky: -0.01,
                 },
                 Deformation::Bend { curvature: 0.01 },
-                Deformation::Rigid(Isometry3::translation(24.0, 0.0, 0.0)),
+                Deformation::Rigid(Isometry3::translation(30.0, 0.0, 0.0)),
             ]),
         );
         let mut both = Node::boolean(Boolean::Union, RFunction::Alpha(0.5), nut, lobes);
