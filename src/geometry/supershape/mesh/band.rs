@@ -85,19 +85,32 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
                 for i in 0..nt {
                     for j in 0..np {
                         let (t0, p0) = (-PI + i as f64 * dt, -FRAC_PI_2 + j as f64 * dp);
-                        sample_patch(&surface, [t0, t0 + dt, p0, p0 + dp], grid.cell, 0, &mut mark);
+                        sample_patch(
+                            &surface,
+                            [t0, t0 + dt, p0, p0 + dp],
+                            grid.cell,
+                            0,
+                            &mut mark,
+                        );
                     }
                 }
             }
             NodeKind::Cuboid { half_extents } => {
                 for axis in 0..3 {
                     for side in [-1.0, 1.0] {
-                        let surface = |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
+                        let surface =
+                            |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
                         let d = 2.0 / BASE_FACE as f64;
                         for i in 0..BASE_FACE {
                             for j in 0..BASE_FACE {
                                 let (u0, v0) = (-1.0 + i as f64 * d, -1.0 + j as f64 * d);
-                                sample_patch(&surface, [u0, u0 + d, v0, v0 + d], grid.cell, 0, &mut mark);
+                                sample_patch(
+                                    &surface,
+                                    [u0, u0 + d, v0, v0 + d],
+                                    grid.cell,
+                                    0,
+                                    &mut mark,
+                                );
                             }
                         }
                     }

@@ -144,7 +144,13 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
 
 /// The point of segment [a, b] (a on primitive i, b on j) where |f_i| = |f_j|, by bisection:
 /// |f_i| - |f_j| is <= 0 at a and >= 0 at b. A start for the curve search near the segment.
-fn balance_point(leaves: &Leaves, i: usize, j: usize, a: Point3<f64>, b: Point3<f64>) -> Point3<f64> {
+fn balance_point(
+    leaves: &Leaves,
+    i: usize,
+    j: usize,
+    a: Point3<f64>,
+    b: Point3<f64>,
+) -> Point3<f64> {
     let gap = |p: &Point3<f64>| leaves.leaves[i].value(p).abs() - leaves.leaves[j].value(p).abs();
     let (mut lo, mut hi) = (a, b);
     for _ in 0..40 {

@@ -61,9 +61,16 @@ impl TriMesh {
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|v| self.vertices[v as usize]);
-                let normal = (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or_default();
+                let normal = (b - a)
+                    .cross(&(c - a))
+                    .try_normalize(0.0)
+                    .unwrap_or_default();
                 stl_io::Triangle {
-                    normal: stl_io::Normal::new([normal.x as f32, normal.y as f32, normal.z as f32]),
+                    normal: stl_io::Normal::new([
+                        normal.x as f32,
+                        normal.y as f32,
+                        normal.z as f32,
+                    ]),
                     vertices: [a, b, c]
                         .map(|p| stl_io::Vertex::new([p.x as f32, p.y as f32, p.z as f32])),
                 }
@@ -187,10 +194,21 @@ mod tests {
 
     #[test]
     fn formats_follow_the_extension() {
-        assert_eq!(MeshFormat::from_path(Path::new("a/b.STL")).unwrap(), MeshFormat::Stl);
-        assert_eq!(MeshFormat::from_path(Path::new("b.ply")).unwrap(), MeshFormat::Ply);
-        assert_eq!(MeshFormat::from_path(Path::new("b.obj")).unwrap(), MeshFormat::Obj);
-        let err = MeshFormat::from_path(Path::new("b.step")).unwrap_err().to_string();
+        assert_eq!(
+            MeshFormat::from_path(Path::new("a/b.STL")).unwrap(),
+            MeshFormat::Stl
+        );
+        assert_eq!(
+            MeshFormat::from_path(Path::new("b.ply")).unwrap(),
+            MeshFormat::Ply
+        );
+        assert_eq!(
+            MeshFormat::from_path(Path::new("b.obj")).unwrap(),
+            MeshFormat::Obj
+        );
+        let err = MeshFormat::from_path(Path::new("b.step"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("b.step"), "{err}");
     }
 
@@ -199,7 +217,8 @@ mod tests {
         let mesh = ellipsoid_mesh();
         let dir = tempfile::tempdir().unwrap();
         let path = path_in(&dir, "part.obj");
-        mesh.write(&path, MeshFormat::from_path(&path).unwrap()).unwrap();
+        mesh.write(&path, MeshFormat::from_path(&path).unwrap())
+            .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.starts_with("# zeroset mesh, units: mm"));
         assert_eq!(read_obj(&text), mesh);
@@ -232,7 +251,13 @@ mod tests {
                 other => panic!("{other:?}"),
             })
             .collect();
-        assert_eq!(TriMesh { vertices, triangles }, mesh);
+        assert_eq!(
+            TriMesh {
+                vertices,
+                triangles
+            },
+            mesh
+        );
     }
 
     #[test]

@@ -53,7 +53,7 @@ pub fn brake_hub() -> Solid {
         body.push(Node::supershape(
             lobe,
             Deformations(vec![
-                Deformation::Scale([5.0, 5.0, 3.0]),
+                Deformation::Scale([3.0, 3.0, 3.0]),
                 Deformation::Bend { curvature: 0.02 },
                 placed(45.0 * angle.cos(), 45.0 * angle.sin(), -4.0, angle),
             ]),
@@ -61,10 +61,7 @@ pub fn brake_hub() -> Solid {
     }
     let mut holes = vec![cylinder(12.0, 20.0, at(0.0, 0.0, 9.0))];
     for side in [-1.0, 1.0] {
-        holes.push(Node::cuboid(
-            [2.5, 2.0, 18.0],
-            at(12.0 * side, 0.0, 9.0),
-        ));
+        holes.push(Node::cuboid([2.5, 2.0, 18.0], at(12.0 * side, 0.0, 9.0)));
     }
     for k in 0..12 {
         let angle = (k as f64 + 0.5) * PI / 6.0;
@@ -138,6 +135,7 @@ fn union_all(mut nodes: Vec<Node>) -> Node {
 
 #[cfg(test)]
 mod tests {
+    use super::super::{polygonise, MeshParams};
     use super::*;
     use nalgebra::Point3;
 
@@ -147,7 +145,12 @@ mod tests {
         assert_eq!(hub.root().counts(), (54, 53));
         // Material in the boss wall, the rib, the rim and the lip; air in the bore, a bolt hole,
         // a stud hole, a radial hole and the relief above the web.
-        for p in [(20.0, 0.0, 9.0), (40.0, 0.0, 10.0), (57.0, 2.0, 3.0), (63.0, 0.0, -1.0)] {
+        for p in [
+            (20.0, 0.0, 9.0),
+            (40.0, 0.0, 10.0),
+            (57.0, 2.0, 3.0),
+            (63.0, 0.0, -1.0),
+        ] {
             assert!(hub.contains(&Point3::new(p.0, p.1, p.2)), "{p:?}");
         }
         let bolt = (PI / 12.0).sin_cos();
@@ -161,5 +164,22 @@ mod tests {
         ] {
             assert!(!hub.contains(&Point3::new(p.0, p.1, p.2)), "{p:?}");
         }
+    }
+
+    #[test]
+    fn the_hub_meshes_closed_with_one_handle_per_through_hole() {
+        let hub = brake_hub();
+        let params = MeshParams::with_cell(1.0);
+        let mesh = polygonise(&hub, &params).unwrap();
+        assert!(mesh.is_closed());
+        // Through holes: the bore (with its keyways), 12 bolt holes, 6 stud holes and 12 radial
+        // holes into the open relief. Genus 31: V - E + F = 2 - 62.
+        assert_eq!(mesh.euler_characteristic(), -60);
+        let worst = mesh
+            .vertices
+            .iter()
+            .map(|v| hub.value(v).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < params.epsilon, "{worst}");
     }
 }

@@ -222,7 +222,11 @@ mod tests {
         // or the lobe (6 %) fails by far.
         let reference = monte_carlo_volume(&solid, 80);
         let error = (mesh.volume() - reference) / reference;
-        assert!(error.abs() < 0.01, "{} vs {reference}: {error}", mesh.volume());
+        assert!(
+            error.abs() < 0.01,
+            "{} vs {reference}: {error}",
+            mesh.volume()
+        );
         // The bore's rims are sharp edges: vertices on both the hexagon's and the bore's surfaces,
         // no farther apart than delta along two circles of radius 6.
         let leaves = leaves::Leaves::new(&solid);

@@ -156,7 +156,14 @@ fn edge_root(
     for _ in 0..MAX_HALVINGS {
         let flipped: Vec<usize> = (0..sa.len()).filter(|&i| sa[i] != sb[i]).collect();
         if let [leaf] = flipped[..] {
-            return Ok((solve_on_segment(leaves, leaf, a, b, epsilon)?, leaf));
+            // The other primitives agree at both ends, but one of them may still be entered and
+            // left in between (an edge clipping a box's corner): the root counts only where
+            // they all keep their end signs; otherwise halve on.
+            let root = solve_on_segment(leaves, leaf, a, b, epsilon)?;
+            let at_root = leaves.signs(&root);
+            if (0..sa.len()).all(|k| k == leaf || at_root[k] == sa[k]) {
+                return Ok((root, leaf));
+            }
         }
         let m = nalgebra::center(&a, &b);
         let sm = leaves.signs(&m);
