@@ -169,7 +169,7 @@ impl Aabb {
         }
     }
 
-    fn intersection(&self, other: &Aabb) -> Aabb {
+    pub fn intersection(&self, other: &Aabb) -> Aabb {
         Aabb {
             min: self.min.sup(&other.min),
             max: self.max.inf(&other.max),
@@ -242,6 +242,12 @@ impl Solid {
     /// The box around the whole solid.
     pub fn bounds(&self) -> Aabb {
         self.bounds[0]
+    }
+
+    /// Every node's box in the model frame, in pre-order of the tree (root first, then the left
+    /// subtree, then the right), for walkers of the tree such as the mesher.
+    pub fn node_bounds(&self) -> &[Aabb] {
+        &self.bounds
     }
 
     /// Whether `p` lies inside the solid (F > 0), skipping the subtrees whose box does not hold it.

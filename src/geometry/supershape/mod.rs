@@ -12,6 +12,7 @@ pub mod csg;
 pub mod deform;
 pub mod distance;
 pub mod formula;
+pub mod mesh;
 pub mod prism;
 pub mod rfunc;
 pub mod shape;

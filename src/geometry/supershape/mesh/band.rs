@@ -1,0 +1,182 @@
+//! The cells of a regular grid that the solid's surface can cross, found from the primitives'
+//! parametric forms (seed 000 section 4, initialisation: each primitive's parametric grid mapped
+//! through the hierarchical deformations). The solid's surface is a subset of the union of its
+//! primitives' surfaces, and the sign of the tree changes only across a primitive's surface, so a
+//! cell that no primitive surface crosses holds no piece of the mesh: only the band around the
+//! sampled surfaces is classified, not the whole box.
+
+use std::collections::HashSet;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use nalgebra::{Point3, Vector3};
+
+use super::super::csg::{Aabb, NodeKind};
+use super::leaves::{Leaf, Leaves};
+
+/// A regular grid of cubic cells over the solid's box, one cell of margin on every side.
+pub(super) struct Grid {
+    origin: Point3<f64>,
+    cell: f64,
+    /// Vertices along each axis.
+    dims: [u64; 3],
+}
+
+impl Grid {
+    pub fn new(bounds: &Aabb, cell: f64) -> Self {
+        let origin = bounds.min - Vector3::repeat(cell);
+        let span = bounds.max - bounds.min;
+        let dims = [0, 1, 2].map(|axis| (span[axis] / cell).ceil() as u64 + 3);
+        Self { origin, cell, dims }
+    }
+
+    pub fn vertex_id(&self, ijk: [u64; 3]) -> u64 {
+        ijk[0] + self.dims[0] * (ijk[1] + self.dims[1] * ijk[2])
+    }
+
+    pub fn vertex_point(&self, ijk: [u64; 3]) -> Point3<f64> {
+        self.origin + Vector3::new(ijk[0] as f64, ijk[1] as f64, ijk[2] as f64) * self.cell
+    }
+
+    /// The cell holding `p` (cells are named by their lowest vertex), if inside the grid.
+    fn cell_of(&self, p: &Point3<f64>) -> Option<[u64; 3]> {
+        let mut ijk = [0; 3];
+        for axis in 0..3 {
+            let t = ((p[axis] - self.origin[axis]) / self.cell).floor();
+            if !(t >= 0.0 && t < (self.dims[axis] - 1) as f64) {
+                return None;
+            }
+            ijk[axis] = t as u64;
+        }
+        Some(ijk)
+    }
+
+    /// Whether a cell has all its vertices inside the grid.
+    fn has_cell(&self, ijk: [i64; 3]) -> bool {
+        (0..3).all(|axis| ijk[axis] >= 0 && (ijk[axis] as u64) + 1 < self.dims[axis])
+    }
+}
+
+/// Base parametric grid before refinement: fine enough that a patch cannot fold over a whole lobe
+/// of the shapes a part model uses (symmetry numbers up to 12 around theta).
+const BASE_SUPERSHAPE: (usize, usize) = (48, 24);
+const BASE_FACE: usize = 4;
+/// Depth limit of the patch refinement: 2^14 subdivisions of a base patch.
+const MAX_DEPTH: u32 = 14;
+
+/// Every cell within one cell of a parametric sample of a primitive's surface, sorted. Patches
+/// are split until their corners are closer than half a cell, so every surface point lies within
+/// half a cell of a sample, and every cell the surface crosses is a neighbour of a sampled cell.
+pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
+    let mut sampled = HashSet::new();
+    for leaf in &leaves.leaves {
+        let clip = leaf.clip;
+        let mut mark = |p: Point3<f64>| {
+            if clip.contains(&p) {
+                if let Some(c) = grid.cell_of(&p) {
+                    sampled.insert(c);
+                }
+            }
+        };
+        match &leaf.node().kind {
+            NodeKind::Supershape { shape } => {
+                let surface = |theta: f64, phi: f64| leaf.to_model(&shape.point(theta, phi));
+                let (nt, np) = BASE_SUPERSHAPE;
+                let (dt, dp) = (2.0 * PI / nt as f64, PI / np as f64);
+                for i in 0..nt {
+                    for j in 0..np {
+                        let (t0, p0) = (-PI + i as f64 * dt, -FRAC_PI_2 + j as f64 * dp);
+                        sample_patch(
+                            &surface,
+                            [t0, t0 + dt, p0, p0 + dp],
+                            grid.cell,
+                            0,
+                            &mut mark,
+                        );
+                    }
+                }
+            }
+            NodeKind::Cuboid { half_extents } => {
+                for axis in 0..3 {
+                    for side in [-1.0, 1.0] {
+                        let surface =
+                            |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
+                        let d = 2.0 / BASE_FACE as f64;
+                        for i in 0..BASE_FACE {
+                            for j in 0..BASE_FACE {
+                                let (u0, v0) = (-1.0 + i as f64 * d, -1.0 + j as f64 * d);
+                                sample_patch(
+                                    &surface,
+                                    [u0, u0 + d, v0, v0 + d],
+                                    grid.cell,
+                                    0,
+                                    &mut mark,
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+            NodeKind::Boolean { .. } => unreachable!("leaves are primitives"),
+        }
+    }
+    let mut band = HashSet::with_capacity(sampled.len() * 4);
+    for c in &sampled {
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let n = [c[0] as i64 + dx, c[1] as i64 + dy, c[2] as i64 + dz];
+                    if grid.has_cell(n) {
+                        band.insert(n.map(|v| v as u64));
+                    }
+                }
+            }
+        }
+    }
+    let mut cells: Vec<[u64; 3]> = band.into_iter().collect();
+    cells.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
+    cells
+}
+
+/// A point of face `axis`/`side` of a box at face coordinates (u, v) in [-1, 1], in the model frame.
+fn face_point(leaf: &Leaf, half: &[f64; 3], axis: usize, side: f64, u: f64, v: f64) -> Point3<f64> {
+    let mut c = [0.0; 3];
+    c[axis] = side * half[axis];
+    c[(axis + 1) % 3] = u * half[(axis + 1) % 3];
+    c[(axis + 2) % 3] = v * half[(axis + 2) % 3];
+    leaf.to_model(&Point3::from(c))
+}
+
+/// Samples the patch [u0, u1] x [v0, v1] of a parametric surface, splitting it in four while its
+/// corners are more than half a cell apart.
+fn sample_patch(
+    surface: &impl Fn(f64, f64) -> Point3<f64>,
+    [u0, u1, v0, v1]: [f64; 4],
+    cell: f64,
+    depth: u32,
+    mark: &mut impl FnMut(Point3<f64>),
+) {
+    let corners = [
+        surface(u0, v0),
+        surface(u1, v0),
+        surface(u1, v1),
+        surface(u0, v1),
+    ];
+    let spread = (corners[0] - corners[2])
+        .norm()
+        .max((corners[1] - corners[3]).norm());
+    if spread <= 0.5 * cell || depth == MAX_DEPTH {
+        for c in corners {
+            mark(c);
+        }
+        return;
+    }
+    let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    for rect in [
+        [u0, um, v0, vm],
+        [um, u1, v0, vm],
+        [um, u1, vm, v1],
+        [u0, um, vm, v1],
+    ] {
+        sample_patch(surface, rect, cell, depth + 1, mark);
+    }
+}

@@ -1,0 +1,209 @@
+//! The CSG tree seen from its primitives: each leaf with the chain of placements above it (so its
+//! own implicit function and parametric surface can be reached from the model frame), its box, and
+//! the Boolean expression that turns the leaves' signs into the solid's. The mesher asks "which
+//! primitive's surface does this root lie on", which the tree's single value cannot answer.
+
+use nalgebra::{Matrix3, Point3, Vector3};
+
+use super::super::csg::{Aabb, Node, NodeKind, Solid};
+use super::super::deform::Deformations;
+use super::super::rfunc::Boolean;
+
+/// One primitive of the tree.
+pub(super) struct Leaf<'a> {
+    /// The primitive node; its own placement is applied by `Node::value`.
+    node: &'a Node,
+    /// The placements of the Boolean nodes above it, outermost (root) first.
+    ancestors: Vec<&'a Deformations>,
+    /// Its box in the model frame.
+    bounds: Aabb,
+    /// Its box cut by every ancestor's box: outside it, its surface cannot be part of the solid's.
+    pub clip: Aabb,
+}
+
+enum Expr {
+    Leaf(usize),
+    Op(Boolean, Box<Expr>, Box<Expr>),
+}
+
+/// The tree as leaves plus the Boolean expression over their signs.
+pub(super) struct Leaves<'a> {
+    pub leaves: Vec<Leaf<'a>>,
+    expr: Expr,
+}
+
+impl<'a> Leaves<'a> {
+    pub fn new(solid: &'a Solid) -> Self {
+        let mut leaves = Vec::new();
+        let mut index = 0;
+        let root_box = solid.node_bounds()[0];
+        let expr = flatten(
+            solid.root(),
+            &[],
+            root_box,
+            solid.node_bounds(),
+            &mut index,
+            &mut leaves,
+        );
+        Self { leaves, expr }
+    }
+
+    /// Each leaf's inside/outside at a model point; a point outside a leaf's box is outside it.
+    pub fn signs(&self, p: &Point3<f64>) -> Vec<bool> {
+        self.leaves.iter().map(|leaf| leaf.is_inside(p)).collect()
+    }
+
+    /// The solid's inside/outside from its leaves' (seed 000: an R-function's sign is the Boolean
+    /// function of its arguments' signs).
+    pub fn classify(&self, signs: &[bool]) -> bool {
+        evaluate(&self.expr, signs)
+    }
+
+    pub fn inside(&self, p: &Point3<f64>) -> bool {
+        self.classify(&self.signs(p))
+    }
+}
+
+fn evaluate(expr: &Expr, signs: &[bool]) -> bool {
+    match expr {
+        Expr::Leaf(i) => signs[*i],
+        Expr::Op(op, left, right) => {
+            let (l, r) = (evaluate(left, signs), evaluate(right, signs));
+            match op {
+                Boolean::Union => l || r,
+                Boolean::Intersection => l && r,
+                Boolean::Difference => l && !r,
+            }
+        }
+    }
+}
+
+/// Walks the tree in the pre-order of `Solid::node_bounds`, collecting the leaves.
+fn flatten<'a>(
+    node: &'a Node,
+    ancestors: &[&'a Deformations],
+    clip: Aabb,
+    bounds: &[Aabb],
+    index: &mut usize,
+    leaves: &mut Vec<Leaf<'a>>,
+) -> Expr {
+    let own = bounds[*index];
+    *index += 1;
+    match &node.kind {
+        NodeKind::Boolean {
+            op, left, right, ..
+        } => {
+            let mut chain = ancestors.to_vec();
+            chain.push(&node.place);
+            let clip = clip.intersection(&own);
+            let l = flatten(left, &chain, clip, bounds, index, leaves);
+            let r = flatten(right, &chain, clip, bounds, index, leaves);
+            Expr::Op(*op, Box::new(l), Box::new(r))
+        }
+        _ => {
+            leaves.push(Leaf {
+                node,
+                ancestors: ancestors.to_vec(),
+                bounds: own,
+                clip: clip.intersection(&own),
+            });
+            Expr::Leaf(leaves.len() - 1)
+        }
+    }
+}
+
+impl Leaf<'_> {
+    pub fn node(&self) -> &Node {
+        self.node
+    }
+
+    /// The point in the frame the leaf's own placement maps into (its parent's).
+    fn to_parent(&self, p: &Point3<f64>) -> Point3<f64> {
+        self.ancestors.iter().fold(*p, |q, d| d.inverse(&q))
+    }
+
+    /// The primitive's implicit function at a model point.
+    pub fn value(&self, p: &Point3<f64>) -> f64 {
+        self.node.value(&self.to_parent(p))
+    }
+
+    /// The primitive's implicit function and its gradient in the model frame.
+    pub fn value_and_gradient(&self, p: &Point3<f64>) -> (f64, Vector3<f64>) {
+        let (q, jacobian) = self.ancestors.iter().fold(
+            (*p, Matrix3::identity()),
+            |(q, jacobian): (Point3<f64>, Matrix3<f64>), d| {
+                let (inner, step) = d.inverse_with_jacobian(&q);
+                (inner, step * jacobian)
+            },
+        );
+        let (value, gradient) = self.node.value_and_gradient(&q);
+        (value, jacobian.transpose() * gradient)
+    }
+
+    pub fn is_inside(&self, p: &Point3<f64>) -> bool {
+        self.bounds.contains(p) && self.value(p) > 0.0
+    }
+
+    /// A point of the primitive's canonical frame (its parametric form) taken to the model frame
+    /// through its own and its ancestors' deformations (seed 000 section 4, initialisation).
+    pub fn to_model(&self, canonical: &Point3<f64>) -> Point3<f64> {
+        let parent = self.node.place.apply(canonical);
+        self.ancestors.iter().rev().fold(parent, |q, d| d.apply(&q))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::hub::brake_hub;
+    use super::*;
+
+    #[test]
+    fn leaf_signs_classify_like_the_solid() {
+        let solid = brake_hub();
+        let leaves = Leaves::new(&solid);
+        assert_eq!(leaves.leaves.len(), solid.root().counts().0);
+        let b = solid.bounds();
+        let (mut inside, mut total) = (0, 0);
+        for i in 0..40 {
+            for j in 0..40 {
+                for k in 0..10 {
+                    let t = Vector3::new(
+                        (i as f64 + 0.3) / 40.0,
+                        (j as f64 + 0.7) / 40.0,
+                        (k as f64 + 0.4) / 10.0,
+                    );
+                    let p = b.min + (b.max - b.min).component_mul(&t);
+                    assert_eq!(leaves.inside(&p), solid.contains(&p), "{p}");
+                    inside += usize::from(solid.contains(&p));
+                    total += 1;
+                }
+            }
+        }
+        assert!(
+            inside > total / 20 && inside < total / 2,
+            "{inside} of {total}"
+        );
+    }
+
+    #[test]
+    fn leaf_gradients_match_finite_differences() {
+        let solid = brake_hub();
+        let leaves = Leaves::new(&solid);
+        let h = 1e-6;
+        for leaf in &leaves.leaves {
+            let c = nalgebra::center(&leaf.bounds.min, &leaf.bounds.max);
+            let p = c + Vector3::new(0.31, -0.17, 0.23);
+            let (value, gradient) = leaf.value_and_gradient(&p);
+            assert!((value - leaf.value(&p)).abs() < 1e-12);
+            let numeric = Vector3::from_fn(|axis, _| {
+                let mut step = Vector3::zeros();
+                step[axis] = h;
+                (leaf.value(&(p + step)) - leaf.value(&(p - step))) / (2.0 * h)
+            });
+            assert!(
+                (numeric - gradient).norm() < 1e-5 * (1.0 + numeric.norm()),
+                "{p}: {gradient} vs {numeric}"
+            );
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! Marching tetrahedra over the band of cells: each cube split into the six Kuhn tetrahedra that
+//! share its main diagonal (so neighbouring cubes agree on every face diagonal), and in each
+//! tetrahedron the piece of surface between its inside and outside corners. A surface vertex sits
+//! on a grid edge and is shared by every tetrahedron around that edge, a surface edge lies in a
+//! tetrahedron face shared by exactly two tetrahedra: the result is closed and edge-manifold by
+//! construction, with no ambiguous case to resolve (unlike marching cubes).
+//!
+//! Each vertex is the root of the primitive whose sign flips along the grid edge, found on that
+//! primitive's own function (the tree's value is a product of R-function partials times it, and
+//! cheaper to get exactly): the vertex remembers its primitive for the sharp-edge step.
+
+use std::collections::HashMap;
+
+use nalgebra::{Point3, Vector3};
+
+use super::band::Grid;
+use super::leaves::Leaves;
+use super::MeshError;
+
+/// A triangulated surface with, for each vertex, the primitives whose surfaces hold it (the
+/// second equal to the first unless the vertex lies on an intersection curve).
+pub(super) struct Surface {
+    pub vertices: Vec<Point3<f64>>,
+    pub on: Vec<(usize, usize)>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Corner offsets of a cube, corner c at (c & 1, c >> 1 & 1, c >> 2 & 1).
+fn corner_offset(c: usize) -> [u64; 3] {
+    [(c & 1) as u64, (c >> 1 & 1) as u64, (c >> 2 & 1) as u64]
+}
+
+/// The six Kuhn tetrahedra of a cube: the monotone paths from corner 0 to corner 7.
+const TETRAHEDRA: [[usize; 4]; 6] = [
+    [0, 1, 3, 7],
+    [0, 1, 5, 7],
+    [0, 2, 3, 7],
+    [0, 2, 6, 7],
+    [0, 4, 5, 7],
+    [0, 4, 6, 7],
+];
+
+pub(super) fn march(
+    leaves: &Leaves,
+    grid: &Grid,
+    cells: &[[u64; 3]],
+    epsilon: f64,
+) -> Result<Surface, MeshError> {
+    let mut signs: HashMap<u64, bool> = HashMap::new();
+    let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
+    let mut surface = Surface {
+        vertices: Vec::new(),
+        on: Vec::new(),
+        triangles: Vec::new(),
+    };
+    for cell in cells {
+        let corners: [[u64; 3]; 8] =
+            std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]));
+        let ids = corners.map(|ijk| grid.vertex_id(ijk));
+        let inside: [bool; 8] = std::array::from_fn(|c| {
+            *signs
+                .entry(ids[c])
+                .or_insert_with(|| leaves.inside(&grid.vertex_point(corners[c])))
+        });
+        if inside.iter().all(|&s| s == inside[0]) {
+            continue;
+        }
+        for tet in TETRAHEDRA {
+            let (ins, outs): (Vec<usize>, Vec<usize>) = tet.iter().partition(|&&c| inside[c]);
+            if ins.is_empty() || outs.is_empty() {
+                continue;
+            }
+            // The surface's corners in cyclic order: a triangle around a lone corner, or the
+            // quadrilateral between two inside and two outside corners.
+            let edges: Vec<(usize, usize)> = match (ins.len(), outs.len()) {
+                (1, _) => outs.iter().map(|&o| (ins[0], o)).collect(),
+                (_, 1) => ins.iter().map(|&i| (i, outs[0])).collect(),
+                _ => vec![
+                    (ins[0], outs[0]),
+                    (ins[0], outs[1]),
+                    (ins[1], outs[1]),
+                    (ins[1], outs[0]),
+                ],
+            };
+            // Orientation from the edges' midpoints in grid units (never degenerate, unlike the
+            // roots, which may crowd at a corner): normals point from inside to outside.
+            let offset = |c: usize| Vector3::from(corner_offset(c).map(|v| v as f64));
+            let mid = |(a, b): (usize, usize)| (offset(a) + offset(b)) * 0.5;
+            let outward = outs.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / outs.len() as f64
+                - ins.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / ins.len() as f64;
+            let normal = (mid(edges[1]) - mid(edges[0])).cross(&(mid(edges[2]) - mid(edges[0])));
+            let mut loop_ids = Vec::with_capacity(4);
+            for &(i, o) in &edges {
+                let key = (ids[i].min(ids[o]), ids[i].max(ids[o]));
+                let vertex = match roots.get(&key) {
+                    Some(&v) => v,
+                    None => {
+                        let (point, leaf) = edge_root(
+                            leaves,
+                            grid.vertex_point(corners[i]),
+                            grid.vertex_point(corners[o]),
+                            epsilon,
+                        )?;
+                        surface.vertices.push(point);
+                        surface.on.push((leaf, leaf));
+                        let v = (surface.vertices.len() - 1) as u32;
+                        roots.insert(key, v);
+                        v
+                    }
+                };
+                loop_ids.push(vertex);
+            }
+            if normal.dot(&outward) < 0.0 {
+                loop_ids.reverse();
+            }
+            push_polygon(&mut surface, &loop_ids);
+        }
+    }
+    Ok(surface)
+}
+
+/// A triangle, or a quadrilateral cut along its shorter diagonal (either cut keeps the loop's
+/// orientation).
+fn push_polygon(surface: &mut Surface, ids: &[u32]) {
+    if let [a, b, c] = *ids {
+        surface.triangles.push([a, b, c]);
+        return;
+    }
+    let [a, b, c, d] = [ids[0], ids[1], ids[2], ids[3]];
+    let p = |v: u32| surface.vertices[v as usize];
+    if (p(a) - p(c)).norm() <= (p(b) - p(d)).norm() {
+        surface.triangles.push([a, b, c]);
+        surface.triangles.push([a, c, d]);
+    } else {
+        surface.triangles.push([a, b, d]);
+        surface.triangles.push([b, c, d]);
+    }
+}
+
+/// Halvings of a grid edge while more than one primitive changes sign along it.
+const MAX_HALVINGS: u32 = 60;
+const MAX_SECANT_STEPS: u32 = 100;
+
+/// The point where the solid's sign flips between `inside` (in) and `outside`, with the primitive
+/// whose surface holds it. While several primitives change sign along the segment it is halved,
+/// keeping the half where the solid's sign flips; then the one primitive left is solved on the
+/// segment by regula falsi (Illinois variant) until |f| is far below epsilon.
+fn edge_root(
+    leaves: &Leaves,
+    inside: Point3<f64>,
+    outside: Point3<f64>,
+    epsilon: f64,
+) -> Result<(Point3<f64>, usize), MeshError> {
+    let (mut a, mut b) = (inside, outside);
+    let (mut sa, mut sb) = (leaves.signs(&a), leaves.signs(&b));
+    for _ in 0..MAX_HALVINGS {
+        let flipped: Vec<usize> = (0..sa.len()).filter(|&i| sa[i] != sb[i]).collect();
+        if let [leaf] = flipped[..] {
+            // The other primitives agree at both ends, but one of them may still be entered and
+            // left in between (an edge clipping a box's corner): the root counts only where
+            // they all keep their end signs; otherwise halve on.
+            let root = solve_on_segment(leaves, leaf, a, b, epsilon)?;
+            let at_root = leaves.signs(&root);
+            if (0..sa.len()).all(|k| k == leaf || at_root[k] == sa[k]) {
+                return Ok((root, leaf));
+            }
+        }
+        let m = nalgebra::center(&a, &b);
+        let sm = leaves.signs(&m);
+        if leaves.classify(&sm) {
+            (a, sa) = (m, sm);
+        } else {
+            (b, sb) = (m, sm);
+        }
+    }
+    // The segment has shrunk to rounding: several surfaces meet here. Keep the primitive that is
+    // closest to zero; the tree's residual is checked on every vertex at the end.
+    let m = nalgebra::center(&a, &b);
+    let leaf = (0..sa.len())
+        .filter(|&i| sa[i] != sb[i])
+        .min_by(|&i, &j| {
+            let (fi, fj) = (leaves.leaves[i].value(&m), leaves.leaves[j].value(&m));
+            fi.abs().total_cmp(&fj.abs())
+        })
+        .ok_or(MeshError::NoRoot { near: m })?;
+    Ok((m, leaf))
+}
+
+/// Regula falsi on one primitive's function along [a, b], where it changes sign.
+fn solve_on_segment(
+    leaves: &Leaves,
+    leaf: usize,
+    a: Point3<f64>,
+    b: Point3<f64>,
+    epsilon: f64,
+) -> Result<Point3<f64>, MeshError> {
+    let f = |t: f64| leaves.leaves[leaf].value(&(a + (b - a) * t));
+    let (mut t0, mut t1) = (0.0, 1.0);
+    let (mut f0, mut f1) = (f(t0), f(t1));
+    if f0 * f1 > 0.0 {
+        return Err(MeshError::NoRoot { near: a });
+    }
+    let tolerance = 1e-3 * epsilon;
+    let mut side = 0;
+    for _ in 0..MAX_SECANT_STEPS {
+        let t = if f0 == f1 {
+            0.5 * (t0 + t1)
+        } else {
+            (t0 * f1 - t1 * f0) / (f1 - f0)
+        };
+        let ft = f(t);
+        if ft.abs() < tolerance || t1 - t0 < 1e-15 {
+            return Ok(a + (b - a) * t);
+        }
+        if (ft > 0.0) == (f0 > 0.0) {
+            (t0, f0) = (t, ft);
+            if side == -1 {
+                f1 *= 0.5;
+            }
+            side = -1;
+        } else {
+            (t1, f1) = (t, ft);
+            if side == 1 {
+                f0 *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Err(MeshError::NoRoot { near: a })
+}
