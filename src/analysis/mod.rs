@@ -7,6 +7,7 @@
 pub mod deviation;
 pub mod edges;
 mod nominals;
+pub mod part_mesh;
 pub mod reference;
 pub mod stats;
 #[cfg(test)]

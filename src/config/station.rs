@@ -56,6 +56,9 @@ pub struct ProbeSettings {
     pub travel_mm_s: f64,
     pub probing_mm_s: f64,
     pub scanning_mm_s: f64,
+    /// The stylus shank above the ball, along the machine's z axis: the clearance checks sweep it with the ball.
+    pub shank_radius_mm: f64,
+    pub shank_length_mm: f64,
 }
 
 /// Limits the station keeps to so that it does not hit the part.
@@ -66,6 +69,9 @@ pub struct Safety {
     pub clearance_z_mm: f64,
     /// A tool whose ball is bigger than this is refused.
     pub max_ball_radius_mm: f64,
+    /// The closest the stylus may come to the part model on a move off the surface (a descent to a scan's entry,
+    /// a way out); an inspection with a move closer than this is refused before it starts.
+    pub move_margin_mm: f64,
 }
 
 /// Where the station writes.
@@ -171,6 +177,12 @@ impl StationConfig {
                 safety.clearance_z_mm, safety.max_ball_radius_mm
             ));
         }
+        if !(safety.move_margin_mm >= 0.0 && safety.move_margin_mm.is_finite()) {
+            return Err(format!(
+                "[safety] move_margin_mm = {} must be zero or more",
+                safety.move_margin_mm
+            ));
+        }
         let pose = &self.part_to_machine;
         if !finite(&[
             pose.x_mm,
@@ -219,6 +231,16 @@ impl ProbeSettings {
             return Err(format!(
                 "[probe] speeds must be above zero (got travel {}, probing {}, scanning {} mm/s)",
                 self.travel_mm_s, self.probing_mm_s, self.scanning_mm_s
+            ));
+        }
+        if !(self.shank_radius_mm > 0.0
+            && self.shank_length_mm > 0.0
+            && self.shank_radius_mm.is_finite()
+            && self.shank_length_mm.is_finite())
+        {
+            return Err(format!(
+                "[probe] the shank needs a radius and a length above zero (got {} and {} mm)",
+                self.shank_radius_mm, self.shank_length_mm
             ));
         }
         Ok(())

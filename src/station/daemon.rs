@@ -8,7 +8,9 @@ use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc, oneshot};
 
 use super::finish::{self, Outcome, ReportInputs};
-use super::job::{load_plan, load_reference, reference_path, Job, JobError, Phase};
+use super::job::{
+    check_inspection_moves, load_plan, load_reference, reference_path, Job, JobError, Phase,
+};
 use super::journal::{open_jobs, JobState};
 use super::pipeline::{scan_ref, Pipeline, QUEUE_POINTS};
 use super::worker::{Order, WorkerError, WorkerHandle};
@@ -153,7 +155,11 @@ impl Daemon {
             let plan = load_plan(&self.config, part)?;
             let reference = match kind {
                 JobKind::Teach => None,
-                JobKind::Inspect => Some(load_reference(&self.config, &plan)?),
+                JobKind::Inspect => {
+                    let loaded = load_reference(&self.config, &plan)?;
+                    check_inspection_moves(&self.config, &plan, &loaded.0)?;
+                    Some(loaded)
+                }
             };
             Job::create(&self.config, kind, plan, serial, reference)
         })();

@@ -7,6 +7,7 @@
 //! to the entry, held off the surface by a margin, and leaves vertically the way it came in.
 
 use nalgebra::{Point3, Vector3};
+use zeroset_drivers::machine::CurveScan;
 
 /// A known stretch of surface along which the ball travelled, and where its scan entered.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,6 +43,26 @@ const WAYPOINT_TURN_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
 const ON_PATH_TOLERANCE_MM: f64 = 3.0;
 
 impl KnownPath {
+    /// The nominal curve of a curve scan, entered at its first nominal (the plan puts the entry there).
+    pub fn of_curve_scan(scan: &CurveScan) -> Self {
+        let (surface, normals) = scan
+            .nominals
+            .iter()
+            .map(|n| {
+                (
+                    Point3::new(n.point.x, n.point.y, n.point.z),
+                    Vector3::new(n.normal.x, n.normal.y, n.normal.z),
+                )
+            })
+            .unzip();
+        KnownPath {
+            surface,
+            normals,
+            closed: scan.closed,
+            entry: 0,
+        }
+    }
+
     /// Where the ball enters and leaves this path: above the entry point by the ball radius and `margin`.
     pub fn entry_offset(&self, ball_radius: f64, margin: f64) -> Point3<f64> {
         self.surface[self.entry] + self.normals[self.entry] * (ball_radius + margin)

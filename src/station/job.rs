@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
 
+use super::clearance;
 use super::escape::KnownPath;
 use super::journal::{file_stem, JobDir, JobRecord, JobState};
 use super::pipeline::{scan_ref, PipelineMsg};
@@ -245,12 +246,7 @@ impl Job {
 
     /// How far the probe keeps off the known surface when entering and leaving a scan, mm.
     pub fn margin_mm(&self) -> f64 {
-        match self.record.kind {
-            JobKind::Teach => TEACH_MARGIN_MM,
-            JobKind::Inspect => {
-                self.plan.scan_settings().max_deviation_mm + INSPECT_EXTRA_MARGIN_MM
-            }
-        }
+        scan_margin_mm(&self.plan, self.record.kind)
     }
 
     /// Where a profile's scan starts, machine coordinates: for choosing the next scan nearest a machine.
@@ -284,22 +280,7 @@ impl Job {
                 let plan = self
                     .plan
                     .curve_scan(key, &reference.profiles[key.profile].nominals);
-                let (surface, normals) = plan
-                    .nominals
-                    .iter()
-                    .map(|n| {
-                        (
-                            Point3::new(n.point.x, n.point.y, n.point.z),
-                            Vector3::new(n.normal.x, n.normal.y, n.normal.z),
-                        )
-                    })
-                    .unzip();
-                let path = KnownPath {
-                    surface,
-                    normals,
-                    closed: plan.closed,
-                    entry: 0,
-                };
+                let path = KnownPath::of_curve_scan(&plan);
                 (Scan::Curve(plan), path)
             }
             None => {
@@ -345,6 +326,43 @@ impl Job {
 }
 
 /// The scans a job of this kind makes.
+/// How far the probe keeps off the known surface when entering and leaving a scan of a job of `kind`, mm.
+fn scan_margin_mm(plan: &Plan, kind: JobKind) -> f64 {
+    match kind {
+        JobKind::Teach => TEACH_MARGIN_MM,
+        JobKind::Inspect => plan.scan_settings().max_deviation_mm + INSPECT_EXTRA_MARGIN_MM,
+    }
+}
+
+/// Refuses an inspection whose descents or ways out would bring the stylus closer to the taught part than the
+/// station's move margin (`clearance`).
+pub fn check_inspection_moves(
+    config: &StationConfig,
+    plan: &Plan,
+    reference: &Reference,
+) -> Result<(), JobError> {
+    let stylus = clearance::station_stylus(config).map_err(JobError)?;
+    let part = clearance::machine_part(plan, reference).map_err(JobError)?;
+    let moves = clearance::inspection_moves(
+        plan,
+        reference,
+        &job_scans(plan, JobKind::Inspect),
+        stylus.ball_radius_mm,
+        scan_margin_mm(plan, JobKind::Inspect),
+        config.safety.clearance_z_mm,
+    )
+    .map_err(JobError)?
+    .into_iter()
+    .filter(|m| m.kind != clearance::MoveKind::Scan)
+    .collect();
+    let margin = config.safety.move_margin_mm;
+    let checked = clearance::check_moves(&stylus, moves, &part, margin);
+    match clearance::refusal(plan, &checked, margin) {
+        Some(message) => Err(JobError(message)),
+        None => Ok(()),
+    }
+}
+
 pub fn job_scans(plan: &Plan, kind: JobKind) -> Vec<ProfileKey> {
     match kind {
         JobKind::Teach => plan.teach_scans(),

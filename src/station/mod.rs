@@ -2,6 +2,7 @@
 //! one task serves the control socket (`control`), and one task owns the station's state and makes every decision
 //! (`daemon`): which machine scans what next, when a job stops, resumes, or ends. They talk only through channels.
 
+pub mod clearance;
 pub mod clock;
 mod control;
 mod daemon;
