@@ -23,6 +23,8 @@ fn probe() -> ProbeSettings {
         travel_mm_s: 100.0,
         probing_mm_s: 5.0,
         scanning_mm_s: 20.0,
+        shank_radius_mm: 0.6,
+        shank_length_mm: 30.0,
     }
 }
 
@@ -30,6 +32,7 @@ fn safety() -> Safety {
     Safety {
         clearance_z_mm: CLEARANCE_MM,
         max_ball_radius_mm: 1.5,
+        move_margin_mm: 0.5,
     }
 }
 
