@@ -12,6 +12,10 @@
 //! The answer is the nearest kept candidate. Nothing here is first order: neither the radial value
 //! 1 - OP/OI nor |F| / |grad F|.
 //!
+//! [`SolidDistance::foot_in_section`] does the same within a section plane z = z0 (a planar profile
+//! scan): the plane joins each feature's constraints, so patches become section curves and edges
+//! the points where they pierce the plane.
+//!
 //! Completeness: the search visits the samples by increasing distance and stops once they are
 //! farther than the best candidate plus the sampling gap, so every patch or edge that comes closer
 //! than the answer has had a Newton solve seeded within one gap of its nearest point. A feature
@@ -22,10 +26,10 @@ mod lagrange;
 mod model;
 mod samples;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::csg::Solid;
-use lagrange::{nearest_on, project};
+use lagrange::{nearest_on, project, Surfaces};
 use model::Model;
 use samples::{sample, Feature, Samples};
 
@@ -67,10 +71,17 @@ pub struct SolidDistance {
 }
 
 impl SolidDistance {
+    /// Prepares the distance to `solid` with boundary samples about 1/128 of its bounding box's
+    /// diagonal apart.
     pub fn new(solid: &Solid) -> Self {
+        Self::with_spacing(solid, solid.bounds().diagonal() / SAMPLES_PER_DIAGONAL)
+    }
+
+    /// Prepares the distance with neighbouring boundary samples about `spacing_mm` apart: finer for
+    /// a part whose smallest feature (a small bore, a narrow face) is under the default spacing.
+    pub fn with_spacing(solid: &Solid, spacing_mm: f64) -> Self {
         let model = Model::new(solid);
-        let spacing = solid.bounds().diagonal() / SAMPLES_PER_DIAGONAL;
-        let samples = sample(&model, spacing);
+        let samples = sample(&model, spacing_mm);
         Self {
             solid: solid.clone(),
             model,
@@ -81,16 +92,59 @@ impl SolidDistance {
     /// The nearest boundary point to `p`. `None` only if the solid has no boundary samples (empty) or
     /// no Newton solve converged.
     pub fn foot(&self, p: &Point3<f64>) -> Option<Foot> {
+        let (distance, point, feature) = self.search(p, |feature, seed| {
+            let max_step = self.max_step(p, seed);
+            match feature {
+                Feature::Surface(s) => nearest_on::<1, 4>(&self.model, [s], p, seed, max_step),
+                Feature::Edge(a, b) => nearest_on::<2, 5>(&self.model, [a, b], p, seed, max_step),
+                Feature::Vertex(a, b, c) => project(&self.model, [a, b, c], seed, max_step),
+            }
+        })?;
+        Some(self.foot_at(p, distance, point, feature, Some))
+    }
+
+    /// The 2-D distance within the section plane through `p` normal to the model's z axis (the plane
+    /// z = p.z of a planar profile scan): the nearest point of the solid's section curve, which is
+    /// made of the patches' sections (Lagrange conditions with the plane as one more constraint)
+    /// and the points where edges pierce the plane. The normal is the section curve's, in the plane.
+    pub fn foot_in_section(&self, p: &Point3<f64>) -> Option<Foot> {
+        let section = Section {
+            model: &self.model,
+            z: p.z,
+        };
+        let plane = self.model.surfaces.len();
+        let (distance, point, feature) = self.search(p, |feature, seed| {
+            let seed = Point3::new(seed.x, seed.y, p.z);
+            let max_step = self.max_step(p, &seed);
+            match feature {
+                Feature::Surface(s) => nearest_on::<2, 5>(&section, [s, plane], p, &seed, max_step),
+                Feature::Edge(a, b) => project(&section, [a, b, plane], &seed, max_step),
+                // Three surfaces and the plane meet only by accident.
+                Feature::Vertex(..) => None,
+            }
+        })?;
+        Some(self.foot_at(p, distance, point, feature, |n| {
+            Vector3::new(n.x, n.y, 0.0).try_normalize(1e-12)
+        }))
+    }
+
+    /// Visits the boundary samples by increasing distance from `p`, solves `solve` (the nearest
+    /// point of a feature from a seed) once per feature and neighbourhood, and keeps the nearest
+    /// solution on the boundary. Stops once samples are farther than that plus the sampling gap.
+    fn search(
+        &self,
+        p: &Point3<f64>,
+        solve: impl Fn(Feature, &Point3<f64>) -> Option<Point3<f64>>,
+    ) -> Option<(f64, Point3<f64>, Feature)> {
         let gap = self.samples.gap;
         let mut best: Option<(f64, Point3<f64>, Feature)> = None;
         // Seeds and feet already tried, by feature: a sample within two gaps of one of them would
         // lead Newton to the same point.
         let mut tried: Vec<(Feature, Point3<f64>)> = Vec::new();
-        let query = [p.x, p.y, p.z];
         for (sample, distance2) in self
             .samples
             .tree
-            .nearest_neighbor_iter_with_distance_2(query)
+            .nearest_neighbor_iter_with_distance_2([p.x, p.y, p.z])
             .take(MAX_VISITED)
         {
             if best.is_some_and(|(d, _, _)| distance2.sqrt() > d + gap) {
@@ -104,7 +158,7 @@ impl SolidDistance {
                 continue;
             }
             tried.push((sample.feature, seed));
-            let Some(x) = self.solve(sample.feature, p, &seed) else {
+            let Some(x) = solve(sample.feature, &seed) else {
                 continue;
             };
             tried.push((sample.feature, x));
@@ -115,47 +169,56 @@ impl SolidDistance {
                 }
             }
         }
-        let (distance, point, feature) = best?;
-        let outside = !self.solid.contains(p);
-        let sign = if outside { 1.0 } else { -1.0 };
+        best
+    }
+
+    /// A Newton step is bounded by the larger of the sampling gap and half the distance from the
+    /// seed to p, so that it cannot leave the seed's branch at once.
+    fn max_step(&self, p: &Point3<f64>, seed: &Point3<f64>) -> f64 {
+        self.samples.gap.max(0.5 * (p - seed).norm())
+    }
+
+    /// The foot with its sign, kind and outward normal; `project` maps a surface normal into the
+    /// space the distance is measured in (the identity in 3-D, the section plane in 2-D).
+    fn foot_at(
+        &self,
+        p: &Point3<f64>,
+        distance: f64,
+        point: Point3<f64>,
+        feature: Feature,
+        project: impl Fn(Vector3<f64>) -> Option<Vector3<f64>>,
+    ) -> Foot {
+        let sign = if self.solid.contains(p) { -1.0 } else { 1.0 };
+        // From the foot to p, outward: the normal at an edge, where the normal cone holds it.
+        let towards_p = (distance > 1e-9).then(|| (p - point) * (sign / distance));
         let (normal, kind) = match feature {
-            Feature::Surface(s) => (self.oriented_normal(s, &point), FootKind::Face),
+            Feature::Surface(s) => (
+                project(self.oriented_normal(s, &point)).or(towards_p),
+                FootKind::Face,
+            ),
             Feature::Edge(..) | Feature::Vertex(..) => {
+                // On the edge itself: the mean of the faces' normals, inside the cone.
+                let mean = || {
+                    let sum: Vector3<f64> = feature
+                        .surfaces()
+                        .iter()
+                        .map(|&s| self.oriented_normal(s, &point))
+                        .sum();
+                    project(sum.normalize()).map(|n| n.normalize())
+                };
                 let kind = if matches!(feature, Feature::Edge(..)) {
                     FootKind::Edge
                 } else {
                     FootKind::Vertex
                 };
-                let normal = if distance > 1e-9 {
-                    (p - point) * (sign / distance)
-                } else {
-                    // On the edge itself: the mean of the faces' normals, inside the cone.
-                    feature
-                        .surfaces()
-                        .iter()
-                        .map(|&s| self.oriented_normal(s, &point))
-                        .sum::<Vector3<f64>>()
-                        .normalize()
-                };
-                (normal, kind)
+                (towards_p.or_else(mean), kind)
             }
         };
-        Some(Foot {
+        Foot {
             distance_mm: sign * distance,
             point,
-            normal,
+            normal: normal.unwrap_or_else(Vector3::zeros),
             kind,
-        })
-    }
-
-    /// Newton's nearest point on `feature` from `seed`; a step is bounded by the larger of the
-    /// sampling gap and half the distance to p, so that it cannot leave the seed's branch at once.
-    fn solve(&self, feature: Feature, p: &Point3<f64>, seed: &Point3<f64>) -> Option<Point3<f64>> {
-        let max_step = self.samples.gap.max(0.5 * (p - seed).norm());
-        match feature {
-            Feature::Surface(s) => nearest_on::<1, 4>(&self.model, [s], p, seed, max_step),
-            Feature::Edge(a, b) => nearest_on::<2, 5>(&self.model, [a, b], p, seed, max_step),
-            Feature::Vertex(a, b, c) => project(&self.model, [a, b, c], seed, max_step),
         }
     }
 
@@ -168,6 +231,30 @@ impl SolidDistance {
             -gradient
         } else {
             gradient
+        }
+    }
+}
+
+/// The model's surfaces and, as one more surface after them, the section plane z = `z`.
+struct Section<'a> {
+    model: &'a Model,
+    z: f64,
+}
+
+impl Surfaces for Section<'_> {
+    fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>) {
+        if s == self.model.surfaces.len() {
+            (x.z - self.z, Vector3::z())
+        } else {
+            self.model.value_and_gradient(s, x)
+        }
+    }
+
+    fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64> {
+        if s == self.model.surfaces.len() {
+            Matrix3::zeros()
+        } else {
+            self.model.hessian(s, x, gradient)
         }
     }
 }

@@ -12,7 +12,11 @@
 
 use nalgebra::{Const, DimMin, Matrix3, Point3, SMatrix, SVector, Vector3};
 
-use super::model::Model;
+/// Smooth constraint surfaces by index: a value (zero on the surface), its gradient and Hessian.
+pub(super) trait Surfaces {
+    fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>);
+    fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64>;
+}
 
 const MAX_ITERATIONS: usize = 40;
 /// Converged when Newton's step is below this (mm). Newton's next step would be of its square.
@@ -24,7 +28,7 @@ const ON_SURFACE_TOLERANCE: f64 = 1e-10;
 /// or near that set). `max_step` bounds each move (mm), so that a step from a poor seed cannot jump
 /// to a far branch. `None` if Newton does not converge.
 pub(super) fn nearest_on<const K: usize, const D: usize>(
-    model: &Model,
+    model: &impl Surfaces,
     surfaces: [usize; K],
     p: &Point3<f64>,
     seed: &Point3<f64>,
@@ -103,7 +107,7 @@ where
 /// A point on the common zero set of `surfaces` near `seed`, by Gauss-Newton's minimal-norm steps
 /// x <- x - G (G^T G)^-1 g (K <= 3 transversal surfaces). `None` if it does not converge.
 pub(super) fn project<const K: usize>(
-    model: &Model,
+    model: &impl Surfaces,
     surfaces: [usize; K],
     seed: &Point3<f64>,
     max_step: f64,

@@ -13,6 +13,7 @@ use super::super::csg::{Node, NodeKind, Solid};
 use super::super::deform::{Deformation, Deformations};
 use super::super::rfunc::Boolean;
 use super::super::shape::Supershape;
+use super::lagrange::Surfaces;
 
 /// A primitive in its canonical frame.
 #[derive(Debug, Clone, Copy)]
@@ -111,48 +112,6 @@ impl Model {
         }
     }
 
-    /// The value and gradient (model frame) of surface `s` at `x`.
-    pub fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>) {
-        let surface = self.surfaces[s];
-        let leaf = &self.leaves[surface.leaf];
-        let (q, jacobian) = leaf.to_canonical_with_jacobian(x);
-        match (leaf.primitive, surface.face) {
-            (Primitive::Supershape(shape), _) => {
-                let q = off_axis(q);
-                (
-                    shape.radial(&q),
-                    jacobian.transpose() * shape.radial_gradient(&q),
-                )
-            }
-            (Primitive::Cuboid(half), Some((axis, positive))) => {
-                let scale = side(positive) / half[axis];
-                (
-                    1.0 - scale * q[axis],
-                    -scale * jacobian.row(axis).transpose(),
-                )
-            }
-            (Primitive::Cuboid(_), None) => unreachable!("a box surface is always a face"),
-        }
-    }
-
-    /// The Hessian of surface `s` at `x` whose gradient there is `gradient`: zero for a face under
-    /// affine places, else forward differences of the analytic gradient, symmetrised.
-    pub fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64> {
-        let surface = self.surfaces[s];
-        if surface.face.is_some() && self.leaves[surface.leaf].affine {
-            return Matrix3::zeros();
-        }
-        let h = self.hessian_step;
-        let mut hessian = Matrix3::zeros();
-        for axis in 0..3 {
-            let mut shifted = *x;
-            shifted[axis] += h;
-            let column = (self.value_and_gradient(s, &shifted).1 - gradient) / h;
-            hessian.set_column(axis, &column);
-        }
-        (hessian + hessian.transpose()) * 0.5
-    }
-
     /// Whether `x` is inside the solid when the listed surfaces' sides are imposed (true: on the
     /// primitive's inner side) instead of evaluated; every other surface is evaluated at `x`.
     pub fn inside_with(&self, x: &Point3<f64>, imposed: &[(usize, bool)]) -> bool {
@@ -216,6 +175,50 @@ impl Model {
     /// The surface index of face (`axis`, `positive`) of the box at leaf `l`.
     pub fn face(&self, l: usize, axis: usize, positive: bool) -> usize {
         self.leaves[l].first_surface + 2 * axis + usize::from(positive)
+    }
+}
+
+impl Surfaces for Model {
+    /// The value and gradient (model frame) of surface `s` at `x`.
+    fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>) {
+        let surface = self.surfaces[s];
+        let leaf = &self.leaves[surface.leaf];
+        let (q, jacobian) = leaf.to_canonical_with_jacobian(x);
+        match (leaf.primitive, surface.face) {
+            (Primitive::Supershape(shape), _) => {
+                let q = off_axis(q);
+                (
+                    shape.radial(&q),
+                    jacobian.transpose() * shape.radial_gradient(&q),
+                )
+            }
+            (Primitive::Cuboid(half), Some((axis, positive))) => {
+                let scale = side(positive) / half[axis];
+                (
+                    1.0 - scale * q[axis],
+                    -scale * jacobian.row(axis).transpose(),
+                )
+            }
+            (Primitive::Cuboid(_), None) => unreachable!("a box surface is always a face"),
+        }
+    }
+
+    /// The Hessian of surface `s` at `x` whose gradient there is `gradient`: zero for a face under
+    /// affine places, else forward differences of the analytic gradient, symmetrised.
+    fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64> {
+        let surface = self.surfaces[s];
+        if surface.face.is_some() && self.leaves[surface.leaf].affine {
+            return Matrix3::zeros();
+        }
+        let h = self.hessian_step;
+        let mut hessian = Matrix3::zeros();
+        for axis in 0..3 {
+            let mut shifted = *x;
+            shifted[axis] += h;
+            let column = (self.value_and_gradient(s, &shifted).1 - gradient) / h;
+            hessian.set_column(axis, &column);
+        }
+        (hessian + hessian.transpose()) * 0.5
     }
 }
 

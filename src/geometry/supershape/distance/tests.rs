@@ -447,3 +447,80 @@ fn a_hex_nut_reads_offsets_along_the_wall_normals() {
     }
     assert_eq!(checked, 2 * 24 * 3 * 2);
 }
+
+#[test]
+fn a_section_reads_the_distance_within_its_plane() {
+    // A ball of radius 7.5 centred at (3, -7, 11), cut by the plane z = 13: a circle of radius
+    // sqrt(7.5^2 - 2^2) about (3, -7).
+    let centre = Point3::new(3.0, -7.0, 11.0);
+    let solid = Solid::new(sphere(
+        7.5,
+        vec![Deformation::Rigid(Isometry3::translation(3.0, -7.0, 11.0))],
+    ));
+    let distance = SolidDistance::new(&solid);
+    let circle = (7.5f64.powi(2) - 4.0).sqrt();
+    for (k, angle) in [0.3f64, 1.7, 3.1, 5.0].into_iter().enumerate() {
+        let d = [0.001, -0.05, 1.0, -2.0][k];
+        let radial = Vector3::new(angle.cos(), angle.sin(), 0.0);
+        let p = centre + radial * (circle + d) + Vector3::new(0.0, 0.0, 2.0);
+        let foot = distance.foot_in_section(&p).unwrap();
+        assert!((foot.distance_mm - d).abs() < 1e-9, "{d}: {foot:?}");
+        assert!((foot.point.z - 13.0).abs() < 1e-12);
+        assert!((foot.normal - radial).norm() < 1e-9);
+        assert!(solid.value(&foot.point).abs() < 1e-12);
+        // Out of the plane the surface comes nearer: the 3-D distance is not the section's.
+        let across = distance.foot(&p).unwrap().distance_mm;
+        assert!((across - ((circle + d).hypot(2.0) - 7.5)).abs() < 1e-9);
+        assert!((across - d).abs() > 0.02 * d.abs());
+    }
+}
+
+#[test]
+fn a_section_of_a_union_meets_the_crease_where_it_pierces_the_plane() {
+    // The two balls of radius 5 at x = -3 and 3 cut by z = 0.3: two circles of radius
+    // sqrt(25 - 0.09) meeting at x = 0, y = +-sqrt(25 - 0.09 - 9).
+    let union = Node::boolean(
+        Boolean::Union,
+        RFunction::P(2),
+        sphere(
+            5.0,
+            vec![Deformation::Rigid(Isometry3::translation(-3.0, 0.0, 0.0))],
+        ),
+        sphere(
+            5.0,
+            vec![Deformation::Rigid(Isometry3::translation(3.0, 0.0, 0.0))],
+        ),
+    );
+    let solid = Solid::new(union);
+    let distance = SolidDistance::new(&solid);
+    let z = 0.3;
+    let radius = (25.0f64 - z * z).sqrt();
+    let crease = (radius * radius - 9.0).sqrt();
+    let centres = [Point3::new(-3.0, 0.0, z), Point3::new(3.0, 0.0, z)];
+    for side in [1.0, -1.0] {
+        for x in [0.0, 0.2] {
+            for t in [0.001, 0.1, 0.5] {
+                let p = Point3::new(x, side * (crease - t), z);
+                let mut expected = x.hypot(t);
+                for (k, centre) in centres.iter().enumerate() {
+                    let foot = centre + (p - centre).normalize() * radius;
+                    if (foot - centres[1 - k]).norm() >= radius {
+                        expected = expected.min(radius - (p - centre).norm());
+                    }
+                }
+                let foot = distance.foot_in_section(&p).unwrap();
+                assert!(
+                    (foot.distance_mm + expected).abs() < 1e-9,
+                    "{p}: {} vs {}",
+                    foot.distance_mm,
+                    -expected
+                );
+                assert!((foot.point.z - z).abs() < 1e-12 && foot.normal.z.abs() < 1e-12);
+                if x == 0.0 {
+                    assert_eq!(foot.kind, FootKind::Edge);
+                }
+                assert!(solid.value(&foot.point).abs() < 1e-9);
+            }
+        }
+    }
+}
