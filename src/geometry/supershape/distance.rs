@@ -31,12 +31,12 @@ use nalgebra::{Matrix3, Point3, Vector3};
 use super::csg::Solid;
 use lagrange::{nearest_on, project, Surfaces};
 use model::Model;
-use samples::{sample, Feature, Samples};
+use samples::{sample, Feature, Sample, Samples};
 
 /// Neighbouring samples about 1/128 of the solid's bounding-box diagonal apart: 0.4 mm on a 50 mm
 /// part, close enough for Newton's basin on the surfaces a part model uses.
 const SAMPLES_PER_DIAGONAL: f64 = 128.0;
-/// Bound on the samples visited per query, for points far from a large solid.
+/// Bound on the samples visited in order before one leads to the boundary.
 const MAX_VISITED: usize = 20_000;
 
 /// What part of the boundary the nearest point lies on.
@@ -128,46 +128,59 @@ impl SolidDistance {
         }))
     }
 
-    /// Visits the boundary samples by increasing distance from `p`, solves `solve` (the nearest
-    /// point of a feature from a seed) once per feature and neighbourhood, and keeps the nearest
-    /// solution on the boundary. Stops once samples are farther than that plus the sampling gap.
+    /// Visits the boundary samples by increasing distance from `p` until one leads to a solution on
+    /// the boundary, then every sample within that distance plus the sampling gap (an unordered
+    /// range query, cheaper than the ordered walk); solves `solve` (the nearest point of a feature
+    /// from a seed) once per feature and neighbourhood and keeps the nearest solution.
     fn search(
         &self,
         p: &Point3<f64>,
         solve: impl Fn(Feature, &Point3<f64>) -> Option<Point3<f64>>,
     ) -> Option<(f64, Point3<f64>, Feature)> {
         let gap = self.samples.gap;
+        let query = [p.x, p.y, p.z];
         let mut best: Option<(f64, Point3<f64>, Feature)> = None;
         // Seeds and feet already tried, by feature: a sample within two gaps of one of them would
         // lead Newton to the same point.
         let mut tried: Vec<(Feature, Point3<f64>)> = Vec::new();
-        for (sample, distance2) in self
-            .samples
-            .tree
-            .nearest_neighbor_iter_with_distance_2([p.x, p.y, p.z])
-            .take(MAX_VISITED)
-        {
-            if best.is_some_and(|(d, _, _)| distance2.sqrt() > d + gap) {
-                break;
-            }
+        let mut visit = |sample: &Sample, best: &mut Option<(f64, Point3<f64>, Feature)>| {
             let seed = Point3::from(sample.point);
             let near = |(feature, q): &(Feature, Point3<f64>)| {
                 *feature == sample.feature && (q - seed).norm() < 2.0 * gap
             };
             if tried.iter().any(near) {
-                continue;
+                return;
             }
             tried.push((sample.feature, seed));
             let Some(x) = solve(sample.feature, &seed) else {
-                continue;
+                return;
             };
             tried.push((sample.feature, x));
             if self.model.on_boundary(&x, &sample.feature.surfaces()) {
                 let d = (x - p).norm();
                 if best.is_none_or(|(b, _, _)| d < b) {
-                    best = Some((d, x, sample.feature));
+                    *best = Some((d, x, sample.feature));
                 }
             }
+        };
+        for sample in self
+            .samples
+            .tree
+            .nearest_neighbor_iter(query)
+            .take(MAX_VISITED)
+        {
+            visit(sample, &mut best);
+            if best.is_some() {
+                break;
+            }
+        }
+        let (first, _, _) = best?;
+        for sample in self
+            .samples
+            .tree
+            .locate_within_distance(query, (first + gap).powi(2))
+        {
+            visit(sample, &mut best);
         }
         best
     }

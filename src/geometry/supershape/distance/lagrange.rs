@@ -23,6 +23,9 @@ const MAX_ITERATIONS: usize = 40;
 const STEP_TOLERANCE: f64 = 1e-10;
 /// And the constraints' values, divided by their gradients' norms (a length in mm), below this.
 const ON_SURFACE_TOLERANCE: f64 = 1e-10;
+/// Below this step (mm) the Hessians are not recomputed: over a micrometre they change by a relative
+/// 1e-3 / (radius of curvature in mm), which leaves the convergence all but quadratic.
+const HESSIAN_REUSE: f64 = 1e-3;
 
 /// The nearest point to `p` on the common zero set of `surfaces`, by Newton from `seed` (a point on
 /// or near that set). `max_step` bounds each move (mm), so that a step from a poor seed cannot jump
@@ -41,6 +44,8 @@ where
     debug_assert_eq!(D, 3 + K);
     let mut x = *seed;
     let mut lambda: SVector<f64, K> = SVector::zeros();
+    let mut hessians = [Matrix3::zeros(); K];
+    let mut last_step = f64::INFINITY;
     for iteration in 0..MAX_ITERATIONS {
         let mut values = [0.0; K];
         let mut gradients = [Vector3::zeros(); K];
@@ -50,12 +55,19 @@ where
         if iteration == 0 {
             lambda = least_squares_multipliers(&gradients, &(x - p))?;
         }
+        // Once Newton's steps are below HESSIAN_REUSE the Hessians of the previous point serve:
+        // they only set the rate of convergence, the fixed point is the exact gradients'.
+        if last_step > HESSIAN_REUSE {
+            for k in 0..K {
+                hessians[k] = model.hessian(surfaces[k], &x, &gradients[k]);
+            }
+        }
         let mut hessian = Matrix3::identity();
         let mut residual: SVector<f64, D> = SVector::zeros();
         let mut jacobian: SMatrix<f64, D, D> = SMatrix::zeros();
         let mut stationarity = x - p;
         for k in 0..K {
-            hessian += model.hessian(surfaces[k], &x, &gradients[k]) * lambda[k];
+            hessian += hessians[k] * lambda[k];
             stationarity += gradients[k] * lambda[k];
             residual[3 + k] = values[k];
             for i in 0..3 {
@@ -82,6 +94,7 @@ where
         }
         x += dx;
         lambda += dlambda;
+        last_step = length;
         let on_surfaces =
             (0..K).all(|k| values[k].abs() <= ON_SURFACE_TOLERANCE * gradients[k].norm());
         if length < STEP_TOLERANCE && on_surfaces {

@@ -115,13 +115,20 @@ impl Model {
     /// Whether `x` is inside the solid when the listed surfaces' sides are imposed (true: on the
     /// primitive's inner side) instead of evaluated; every other surface is evaluated at `x`.
     pub fn inside_with(&self, x: &Point3<f64>, imposed: &[(usize, bool)]) -> bool {
-        self.evaluate(&self.expr, x, imposed)
+        self.evaluate(&self.expr, x, imposed, &[])
     }
 
     /// Whether `x`, lying on every surface of `active`, is on the solid's boundary: near `x` the
     /// active surfaces cut space into 2^k sectors (k <= 3, crossing transversally), and `x` is on the
     /// boundary exactly when the sectors are not all inside or all outside.
     pub fn on_boundary(&self, x: &Point3<f64>, active: &[usize]) -> bool {
+        // The leaves without an active surface answer the same in every sector.
+        let fixed: Vec<Option<bool>> = (0..self.leaves.len())
+            .map(|l| {
+                let touched = active.iter().any(|&s| self.surfaces[s].leaf == l);
+                (!touched).then(|| self.leaf_inside(l, x, &[]))
+            })
+            .collect();
         let sectors = 1usize << active.len();
         let mut imposed = [(0, false); 3];
         let mut first = None;
@@ -129,7 +136,7 @@ impl Model {
             for (k, &s) in active.iter().enumerate() {
                 imposed[k] = (s, sector >> k & 1 == 1);
             }
-            let inside = self.inside_with(x, &imposed[..active.len()]);
+            let inside = self.evaluate(&self.expr, x, &imposed[..active.len()], &fixed);
             match first {
                 None => first = Some(inside),
                 Some(f) if f != inside => return true,
@@ -139,12 +146,23 @@ impl Model {
         false
     }
 
-    fn evaluate(&self, expr: &Expr, x: &Point3<f64>, imposed: &[(usize, bool)]) -> bool {
+    /// The Boolean expression at `x`; `fixed` holds the leaves' insides already known (if any).
+    fn evaluate(
+        &self,
+        expr: &Expr,
+        x: &Point3<f64>,
+        imposed: &[(usize, bool)],
+        fixed: &[Option<bool>],
+    ) -> bool {
         match expr {
-            Expr::Leaf(l) => self.leaf_inside(*l, x, imposed),
+            Expr::Leaf(l) => fixed
+                .get(*l)
+                .copied()
+                .flatten()
+                .unwrap_or_else(|| self.leaf_inside(*l, x, imposed)),
             Expr::Op(op, left, right) => {
-                let left = self.evaluate(left, x, imposed);
-                let right = self.evaluate(right, x, imposed);
+                let left = self.evaluate(left, x, imposed, fixed);
+                let right = self.evaluate(right, x, imposed, fixed);
                 match op {
                     Boolean::Union => left || right,
                     Boolean::Intersection => left && right,
@@ -186,11 +204,8 @@ impl Surfaces for Model {
         let (q, jacobian) = leaf.to_canonical_with_jacobian(x);
         match (leaf.primitive, surface.face) {
             (Primitive::Supershape(shape), _) => {
-                let q = off_axis(q);
-                (
-                    shape.radial(&q),
-                    jacobian.transpose() * shape.radial_gradient(&q),
-                )
+                let (value, gradient) = shape.radial_and_gradient(&off_axis(q));
+                (value, jacobian.transpose() * gradient)
             }
             (Primitive::Cuboid(half), Some((axis, positive))) => {
                 let scale = side(positive) / half[axis];
