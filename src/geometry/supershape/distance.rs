@@ -16,11 +16,13 @@
 //! scan): the plane joins each feature's constraints, so patches become section curves and edges
 //! the points where they pierce the plane.
 //!
-//! Completeness: the search visits the samples by increasing distance and stops once they are
-//! farther than the best candidate plus the sampling gap, so every patch or edge that comes closer
-//! than the answer has had a Newton solve seeded within one gap of its nearest point. A feature
-//! narrower than the sampling gap (a sliver) can be missed; general triple points other than box
-//! corners are not sampled, so a foot exactly at such a vertex is found only through its edges.
+//! Completeness: the search walks the samples by increasing distance until one leads to a solution
+//! on the boundary, at distance d, then solves from every sample within d plus the sampling gap (a
+//! grid cell's diagonal), so every patch or edge that comes closer than d has had a Newton solve
+//! seeded within one gap of its nearest point. A feature narrower than the sampling gap (a sliver)
+//! can be missed ([`SolidDistance::with_spacing`] refines the samples). Triple points other than box
+//! corners (three primitives meeting) are not sampled: for the rare query whose nearest point is
+//! such a vertex the answer is the next candidate, slightly too far.
 
 mod lagrange;
 mod model;

@@ -524,3 +524,46 @@ fn a_section_of_a_union_meets_the_crease_where_it_pierces_the_plane() {
         }
     }
 }
+
+#[test]
+fn around_a_hex_nut_no_boundary_sample_is_nearer_than_the_foot() {
+    // Points anywhere round the nut, near and far from faces, edges and the bore: the exact
+    // distance can exceed the distance to no boundary point, and falls short of the nearest of
+    // a fine independent sampling by at most that sampling's gap.
+    let (solid, _, _, _) = hex_nut();
+    let distance = SolidDistance::new(&solid);
+    let fine = SolidDistance::with_spacing(&solid, 0.15);
+    assert!(fine.samples.gap < 0.5 * distance.samples.gap);
+    let bounds = solid.bounds();
+    let span = bounds.max - bounds.min;
+    let mut below = 0;
+    for i in 0..300 {
+        let u = Vector3::new(
+            (i as f64 * 0.618_034).fract(),
+            (i as f64 * 0.754_878).fract(),
+            (i as f64 * 0.569_840).fract(),
+        );
+        let p = bounds.min - span * 0.1 + span.component_mul(&u) * 1.2;
+        let foot = distance.foot(&p).expect("a foot");
+        check_foot(&solid, &p, &foot);
+        assert_eq!(foot.distance_mm > 0.0, !solid.contains(&p), "{p}");
+        let nearest_sample = fine
+            .samples
+            .tree
+            .nearest_neighbor([p.x, p.y, p.z])
+            .map(|s| (Point3::from(s.point) - p).norm())
+            .unwrap();
+        let exact = foot.distance_mm.abs();
+        assert!(
+            exact <= nearest_sample + 1e-9,
+            "{p}: {exact} > {nearest_sample}"
+        );
+        assert!(
+            exact >= nearest_sample - fine.samples.gap,
+            "{p}: {exact} vs {nearest_sample}"
+        );
+        below += usize::from(exact < nearest_sample - 1e-6);
+    }
+    // The samples are only near the foot: most exact distances are strictly below them.
+    assert!(below > 250, "{below}");
+}
