@@ -20,9 +20,10 @@
 //! on the boundary, at distance d, then solves from every sample within d plus the sampling gap (a
 //! grid cell's diagonal), so every patch or edge that comes closer than d has had a Newton solve
 //! seeded within one gap of its nearest point. A feature narrower than the sampling gap (a sliver)
-//! can be missed ([`SolidDistance::with_spacing`] refines the samples). Triple points other than box
-//! corners (three primitives meeting) are not sampled: for the rare query whose nearest point is
-//! such a vertex the answer is the next candidate, slightly too far.
+//! can be missed ([`SolidDistance::with_spacing`] refines the samples), and so can a vertex (three
+//! surfaces meeting) whose edges are shorter than a grid cell, as vertices are seeded where a grid
+//! cell or a box edge is crossed by two more surfaces; a query whose foot is a missed vertex gets
+//! `None`.
 
 mod lagrange;
 mod model;
@@ -48,7 +49,7 @@ pub enum FootKind {
     Face,
     /// On an intersection curve of two surfaces (a sharp edge): p - foot lies in the normal cone.
     Edge,
-    /// Where three surfaces meet (a box corner).
+    /// Where three surfaces meet (a box corner, or a box edge through a supershape).
     Vertex,
 }
 
@@ -91,8 +92,9 @@ impl SolidDistance {
         }
     }
 
-    /// The nearest boundary point to `p`. `None` only if the solid has no boundary samples (empty) or
-    /// no Newton solve converged.
+    /// The nearest boundary point to `p`. `None` if the solid has no boundary samples (empty) or no
+    /// solve ended on the boundary (the nearest point is a vertex the samples missed: every patch's
+    /// and edge's own nearest point is then hidden), never a wrong distance in that case.
     pub fn foot(&self, p: &Point3<f64>) -> Option<Foot> {
         let (distance, point, feature) = self.search(p, |feature, seed| {
             let max_step = self.max_step(p, seed);

@@ -567,3 +567,32 @@ fn around_a_hex_nut_no_boundary_sample_is_nearer_than_the_foot() {
     // The samples are only near the foot: most exact distances are strictly below them.
     assert!(below > 250, "{below}");
 }
+
+#[test]
+fn where_a_box_edge_pierces_a_ball_the_vertex_is_nearest() {
+    // A ball of radius 10 cut to the square prism |x|, |y| <= 5: the prism's edge x = y = 5 leaves
+    // the ball at the vertex (5, 5, sqrt 50), where the faces x = 5, y = 5 and the sphere meet.
+    let mut cut = Node::boolean(
+        Boolean::Intersection,
+        RFunction::P(2),
+        sphere(10.0, vec![]),
+        Node::cuboid([5.0, 5.0, 20.0], Deformations::default()),
+    );
+    cut.place = Deformations(vec![pose()]);
+    let solid = Solid::new(cut);
+    let distance = SolidDistance::new(&solid);
+    let vertex = Point3::new(5.0, 5.0, 50f64.sqrt());
+    let ball_normal = vertex.coords / 10.0;
+    for (a, b, c) in [(1.0, 1.0, 1.0), (0.2, 1.0, 0.5), (1.0, 0.3, 2.0)] {
+        // Any positive combination of the three normals is in the vertex's normal cone.
+        let direction = (Vector3::x() * a + Vector3::y() * b + ball_normal * c).normalize();
+        for t in [0.001, 0.3, 2.0] {
+            let p = pose().apply(&(vertex + direction * t));
+            let foot = distance.foot(&p).unwrap();
+            assert!((foot.distance_mm - t).abs() < 1e-9, "{t}: {foot:?}");
+            assert_eq!(foot.kind, FootKind::Vertex);
+            assert!((foot.point - pose().apply(&vertex)).norm() < 1e-9);
+            check_foot(&solid, &p, &foot);
+        }
+    }
+}
