@@ -23,7 +23,7 @@
 //! can be missed ([`SolidDistance::with_spacing`] refines the samples), and so can a vertex (three
 //! surfaces meeting) whose edges are shorter than a grid cell, as vertices are seeded where a grid
 //! cell or a box edge is crossed by two more surfaces; a query whose foot is a missed vertex gets
-//! `None`.
+//! `None` or, where the ordered walk reaches another boundary part first, a distance too large.
 
 mod lagrange;
 mod model;
@@ -93,8 +93,8 @@ impl SolidDistance {
     }
 
     /// The nearest boundary point to `p`. `None` if the solid has no boundary samples (empty) or no
-    /// solve ended on the boundary (the nearest point is a vertex the samples missed: every patch's
-    /// and edge's own nearest point is then hidden), never a wrong distance in that case.
+    /// solve ended on the boundary, which happens when the nearest point is a vertex the samples
+    /// missed (every patch's and edge's own nearest point is then hidden).
     pub fn foot(&self, p: &Point3<f64>) -> Option<Foot> {
         let (distance, point, feature) = self.search(p, |feature, seed| {
             let max_step = self.max_step(p, seed);
