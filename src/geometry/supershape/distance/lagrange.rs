@@ -12,19 +12,26 @@
 
 use nalgebra::{Const, DimMin, Matrix3, Point3, SMatrix, SVector, Vector3};
 
-use super::model::Model;
+/// Smooth constraint surfaces by index: a value (zero on the surface), its gradient and Hessian.
+pub(super) trait Surfaces {
+    fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>);
+    fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64>;
+}
 
 const MAX_ITERATIONS: usize = 40;
 /// Converged when Newton's step is below this (mm). Newton's next step would be of its square.
 const STEP_TOLERANCE: f64 = 1e-10;
 /// And the constraints' values, divided by their gradients' norms (a length in mm), below this.
 const ON_SURFACE_TOLERANCE: f64 = 1e-10;
+/// Below this step (mm) the Hessians are not recomputed: over a micrometre they change by a relative
+/// 1e-3 / (radius of curvature in mm), which leaves the convergence all but quadratic.
+const HESSIAN_REUSE: f64 = 1e-3;
 
 /// The nearest point to `p` on the common zero set of `surfaces`, by Newton from `seed` (a point on
 /// or near that set). `max_step` bounds each move (mm), so that a step from a poor seed cannot jump
 /// to a far branch. `None` if Newton does not converge.
 pub(super) fn nearest_on<const K: usize, const D: usize>(
-    model: &Model,
+    model: &impl Surfaces,
     surfaces: [usize; K],
     p: &Point3<f64>,
     seed: &Point3<f64>,
@@ -37,6 +44,8 @@ where
     debug_assert_eq!(D, 3 + K);
     let mut x = *seed;
     let mut lambda: SVector<f64, K> = SVector::zeros();
+    let mut hessians = [Matrix3::zeros(); K];
+    let mut last_step = f64::INFINITY;
     for iteration in 0..MAX_ITERATIONS {
         let mut values = [0.0; K];
         let mut gradients = [Vector3::zeros(); K];
@@ -46,12 +55,19 @@ where
         if iteration == 0 {
             lambda = least_squares_multipliers(&gradients, &(x - p))?;
         }
+        // Once Newton's steps are below HESSIAN_REUSE the Hessians of the previous point serve:
+        // they only set the rate of convergence, the fixed point is the exact gradients'.
+        if last_step > HESSIAN_REUSE {
+            for k in 0..K {
+                hessians[k] = model.hessian(surfaces[k], &x, &gradients[k]);
+            }
+        }
         let mut hessian = Matrix3::identity();
         let mut residual: SVector<f64, D> = SVector::zeros();
         let mut jacobian: SMatrix<f64, D, D> = SMatrix::zeros();
         let mut stationarity = x - p;
         for k in 0..K {
-            hessian += model.hessian(surfaces[k], &x, &gradients[k]) * lambda[k];
+            hessian += hessians[k] * lambda[k];
             stationarity += gradients[k] * lambda[k];
             residual[3 + k] = values[k];
             for i in 0..3 {
@@ -78,6 +94,7 @@ where
         }
         x += dx;
         lambda += dlambda;
+        last_step = length;
         let on_surfaces =
             (0..K).all(|k| values[k].abs() <= ON_SURFACE_TOLERANCE * gradients[k].norm());
         if length < STEP_TOLERANCE && on_surfaces {
@@ -103,7 +120,7 @@ where
 /// A point on the common zero set of `surfaces` near `seed`, by Gauss-Newton's minimal-norm steps
 /// x <- x - G (G^T G)^-1 g (K <= 3 transversal surfaces). `None` if it does not converge.
 pub(super) fn project<const K: usize>(
-    model: &Model,
+    model: &impl Surfaces,
     surfaces: [usize; K],
     seed: &Point3<f64>,
     max_step: f64,

@@ -13,6 +13,7 @@ use super::super::csg::{Node, NodeKind, Solid};
 use super::super::deform::{Deformation, Deformations};
 use super::super::rfunc::Boolean;
 use super::super::shape::Supershape;
+use super::lagrange::Surfaces;
 
 /// A primitive in its canonical frame.
 #[derive(Debug, Clone, Copy)]
@@ -111,58 +112,23 @@ impl Model {
         }
     }
 
-    /// The value and gradient (model frame) of surface `s` at `x`.
-    pub fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>) {
-        let surface = self.surfaces[s];
-        let leaf = &self.leaves[surface.leaf];
-        let (q, jacobian) = leaf.to_canonical_with_jacobian(x);
-        match (leaf.primitive, surface.face) {
-            (Primitive::Supershape(shape), _) => {
-                let q = off_axis(q);
-                (
-                    shape.radial(&q),
-                    jacobian.transpose() * shape.radial_gradient(&q),
-                )
-            }
-            (Primitive::Cuboid(half), Some((axis, positive))) => {
-                let scale = side(positive) / half[axis];
-                (
-                    1.0 - scale * q[axis],
-                    -scale * jacobian.row(axis).transpose(),
-                )
-            }
-            (Primitive::Cuboid(_), None) => unreachable!("a box surface is always a face"),
-        }
-    }
-
-    /// The Hessian of surface `s` at `x` whose gradient there is `gradient`: zero for a face under
-    /// affine places, else forward differences of the analytic gradient, symmetrised.
-    pub fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64> {
-        let surface = self.surfaces[s];
-        if surface.face.is_some() && self.leaves[surface.leaf].affine {
-            return Matrix3::zeros();
-        }
-        let h = self.hessian_step;
-        let mut hessian = Matrix3::zeros();
-        for axis in 0..3 {
-            let mut shifted = *x;
-            shifted[axis] += h;
-            let column = (self.value_and_gradient(s, &shifted).1 - gradient) / h;
-            hessian.set_column(axis, &column);
-        }
-        (hessian + hessian.transpose()) * 0.5
-    }
-
     /// Whether `x` is inside the solid when the listed surfaces' sides are imposed (true: on the
     /// primitive's inner side) instead of evaluated; every other surface is evaluated at `x`.
     pub fn inside_with(&self, x: &Point3<f64>, imposed: &[(usize, bool)]) -> bool {
-        self.evaluate(&self.expr, x, imposed)
+        self.evaluate(&self.expr, x, imposed, &[])
     }
 
     /// Whether `x`, lying on every surface of `active`, is on the solid's boundary: near `x` the
     /// active surfaces cut space into 2^k sectors (k <= 3, crossing transversally), and `x` is on the
     /// boundary exactly when the sectors are not all inside or all outside.
     pub fn on_boundary(&self, x: &Point3<f64>, active: &[usize]) -> bool {
+        // The leaves without an active surface answer the same in every sector.
+        let fixed: Vec<Option<bool>> = (0..self.leaves.len())
+            .map(|l| {
+                let touched = active.iter().any(|&s| self.surfaces[s].leaf == l);
+                (!touched).then(|| self.leaf_inside(l, x, &[]))
+            })
+            .collect();
         let sectors = 1usize << active.len();
         let mut imposed = [(0, false); 3];
         let mut first = None;
@@ -170,7 +136,7 @@ impl Model {
             for (k, &s) in active.iter().enumerate() {
                 imposed[k] = (s, sector >> k & 1 == 1);
             }
-            let inside = self.inside_with(x, &imposed[..active.len()]);
+            let inside = self.evaluate(&self.expr, x, &imposed[..active.len()], &fixed);
             match first {
                 None => first = Some(inside),
                 Some(f) if f != inside => return true,
@@ -180,12 +146,23 @@ impl Model {
         false
     }
 
-    fn evaluate(&self, expr: &Expr, x: &Point3<f64>, imposed: &[(usize, bool)]) -> bool {
+    /// The Boolean expression at `x`; `fixed` holds the leaves' insides already known (if any).
+    fn evaluate(
+        &self,
+        expr: &Expr,
+        x: &Point3<f64>,
+        imposed: &[(usize, bool)],
+        fixed: &[Option<bool>],
+    ) -> bool {
         match expr {
-            Expr::Leaf(l) => self.leaf_inside(*l, x, imposed),
+            Expr::Leaf(l) => fixed
+                .get(*l)
+                .copied()
+                .flatten()
+                .unwrap_or_else(|| self.leaf_inside(*l, x, imposed)),
             Expr::Op(op, left, right) => {
-                let left = self.evaluate(left, x, imposed);
-                let right = self.evaluate(right, x, imposed);
+                let left = self.evaluate(left, x, imposed, fixed);
+                let right = self.evaluate(right, x, imposed, fixed);
                 match op {
                     Boolean::Union => left || right,
                     Boolean::Intersection => left && right,
@@ -216,6 +193,47 @@ impl Model {
     /// The surface index of face (`axis`, `positive`) of the box at leaf `l`.
     pub fn face(&self, l: usize, axis: usize, positive: bool) -> usize {
         self.leaves[l].first_surface + 2 * axis + usize::from(positive)
+    }
+}
+
+impl Surfaces for Model {
+    /// The value and gradient (model frame) of surface `s` at `x`.
+    fn value_and_gradient(&self, s: usize, x: &Point3<f64>) -> (f64, Vector3<f64>) {
+        let surface = self.surfaces[s];
+        let leaf = &self.leaves[surface.leaf];
+        let (q, jacobian) = leaf.to_canonical_with_jacobian(x);
+        match (leaf.primitive, surface.face) {
+            (Primitive::Supershape(shape), _) => {
+                let (value, gradient) = shape.radial_and_gradient(&off_axis(q));
+                (value, jacobian.transpose() * gradient)
+            }
+            (Primitive::Cuboid(half), Some((axis, positive))) => {
+                let scale = side(positive) / half[axis];
+                (
+                    1.0 - scale * q[axis],
+                    -scale * jacobian.row(axis).transpose(),
+                )
+            }
+            (Primitive::Cuboid(_), None) => unreachable!("a box surface is always a face"),
+        }
+    }
+
+    /// The Hessian of surface `s` at `x` whose gradient there is `gradient`: zero for a face under
+    /// affine places, else forward differences of the analytic gradient, symmetrised.
+    fn hessian(&self, s: usize, x: &Point3<f64>, gradient: &Vector3<f64>) -> Matrix3<f64> {
+        let surface = self.surfaces[s];
+        if surface.face.is_some() && self.leaves[surface.leaf].affine {
+            return Matrix3::zeros();
+        }
+        let h = self.hessian_step;
+        let mut hessian = Matrix3::zeros();
+        for axis in 0..3 {
+            let mut shifted = *x;
+            shifted[axis] += h;
+            let column = (self.value_and_gradient(s, &shifted).1 - gradient) / h;
+            hessian.set_column(axis, &column);
+        }
+        (hessian + hessian.transpose()) * 0.5
     }
 }
 

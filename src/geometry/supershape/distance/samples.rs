@@ -1,6 +1,7 @@
 //! Seeds for the nearest-point search: every surface sampled on a parametric grid mapped into the
-//! model frame, the intersection curves found where a grid step crosses another surface, and the
-//! boxes' own edges and corners; only the samples that lie on the solid's boundary are kept, in an
+//! model frame, the intersection curves found where a grid step crosses another surface, the
+//! vertices where a grid cell or a box edge is crossed by two more, and the boxes' own edges and
+//! corners; only the samples that lie on the solid's boundary are kept, in an
 //! R-tree.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -23,6 +24,12 @@ pub(super) enum Feature {
 impl Feature {
     fn edge(a: usize, b: usize) -> Self {
         Feature::Edge(a.min(b), a.max(b))
+    }
+
+    fn vertex(a: usize, b: usize, c: usize) -> Self {
+        let mut sorted = [a, b, c];
+        sorted.sort_unstable();
+        Feature::Vertex(sorted[0], sorted[1], sorted[2])
     }
 
     pub fn surfaces(&self) -> Vec<usize> {
@@ -71,6 +78,23 @@ struct Grid {
 }
 
 impl Grid {
+    /// The four corners of every grid cell.
+    fn cells(&self) -> impl Iterator<Item = [usize; 4]> + '_ {
+        let (rows, columns) = (self.rows, self.columns);
+        let across = if self.wraps { columns } else { columns - 1 };
+        (0..rows.saturating_sub(1)).flat_map(move |i| {
+            (0..across).map(move |j| {
+                let next = (j + 1) % columns;
+                [
+                    i * columns + j,
+                    i * columns + next,
+                    (i + 1) * columns + j,
+                    (i + 1) * columns + next,
+                ]
+            })
+        })
+    }
+
     /// The index pairs of grid neighbours along rows and columns.
     fn neighbours(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         let (rows, columns) = (self.rows, self.columns);
@@ -125,6 +149,12 @@ pub(super) fn sample(model: &Model, spacing: f64) -> Samples {
                 ));
             }
         }
+        for corners in grid.cells() {
+            if corners.iter().any(|&c| on_boundary[c]) && !corners.iter().all(|&c| on_boundary[c]) {
+                let points = corners.map(|c| grid.points[c]);
+                kept.extend(triple_points(model, s, &points, spacing));
+            }
+        }
     }
     for l in 0..model.leaves.len() {
         if let Primitive::Cuboid(half) = model.leaves[l].primitive {
@@ -171,8 +201,48 @@ fn edge_crossings(
     found
 }
 
-/// Samples along a box's twelve edges and at its eight corners, where they are on the boundary,
-/// with the largest spacing along an edge.
+/// The points where `s` meets two other surfaces inside the grid cell with corners `points`, when
+/// they lie on the solid's boundary (vertices where three primitives meet).
+fn triple_points(model: &Model, s: usize, points: &[Point3<f64>; 4], spacing: f64) -> Vec<Sample> {
+    let crossing: Vec<usize> = (0..model.surfaces.len())
+        .filter(|&t| model.surfaces[t].leaf != model.surfaces[s].leaf)
+        .filter(|&t| {
+            let inside = points.map(|x| model.value(t, &x) > 0.0);
+            inside.iter().any(|&v| v) && !inside.iter().all(|&v| v)
+        })
+        .collect();
+    let centre = Point3::from(
+        points
+            .iter()
+            .map(|x| x.coords)
+            .sum::<nalgebra::Vector3<f64>>()
+            / 4.0,
+    );
+    let mut found = Vec::new();
+    for (k, &t) in crossing.iter().enumerate() {
+        for &u in &crossing[k + 1..] {
+            found.extend(vertex_near(model, [s, t, u], &centre, spacing));
+        }
+    }
+    found
+}
+
+/// The vertex of three surfaces near `seed`, if it is on the boundary.
+fn vertex_near(
+    model: &Model,
+    surfaces: [usize; 3],
+    seed: &Point3<f64>,
+    spacing: f64,
+) -> Option<Sample> {
+    let x = project(model, surfaces, seed, spacing)?;
+    ((x - seed).norm() < 2.0 * spacing && model.on_boundary(&x, &surfaces)).then(|| Sample {
+        point: x.coords.into(),
+        feature: Feature::vertex(surfaces[0], surfaces[1], surfaces[2]),
+    })
+}
+
+/// Samples along a box's twelve edges, at its eight corners and where other surfaces cross its
+/// edges, where they are on the boundary, with the largest spacing along an edge.
 fn box_edges(model: &Model, l: usize, half: &[f64; 3], spacing: f64) -> (Vec<Sample>, f64) {
     let leaf = &model.leaves[l];
     let corner = |signs: [bool; 3]| {
@@ -204,6 +274,22 @@ fn box_edges(model: &Model, l: usize, half: &[f64; 3], spacing: f64) -> (Vec<Sam
                 let x = leaf.to_model(&q);
                 if let Some(before) = previous {
                     gap = gap.max((x - before).norm());
+                    // Where another primitive's surface crosses the edge: a vertex.
+                    for t in 0..model.surfaces.len() {
+                        if model.surfaces[t].leaf == l {
+                            continue;
+                        }
+                        let (gb, gx) = (model.value(t, &before), model.value(t, &x));
+                        if (gb > 0.0) != (gx > 0.0) {
+                            let seed = before + (x - before) * (gb / (gb - gx));
+                            found.extend(vertex_near(
+                                model,
+                                [faces[0], faces[1], t],
+                                &seed,
+                                spacing,
+                            ));
+                        }
+                    }
                 }
                 previous = Some(x);
                 if model.on_boundary(&x, &faces) {

@@ -447,3 +447,152 @@ fn a_hex_nut_reads_offsets_along_the_wall_normals() {
     }
     assert_eq!(checked, 2 * 24 * 3 * 2);
 }
+
+#[test]
+fn a_section_reads_the_distance_within_its_plane() {
+    // A ball of radius 7.5 centred at (3, -7, 11), cut by the plane z = 13: a circle of radius
+    // sqrt(7.5^2 - 2^2) about (3, -7).
+    let centre = Point3::new(3.0, -7.0, 11.0);
+    let solid = Solid::new(sphere(
+        7.5,
+        vec![Deformation::Rigid(Isometry3::translation(3.0, -7.0, 11.0))],
+    ));
+    let distance = SolidDistance::new(&solid);
+    let circle = (7.5f64.powi(2) - 4.0).sqrt();
+    for (k, angle) in [0.3f64, 1.7, 3.1, 5.0].into_iter().enumerate() {
+        let d = [0.001, -0.05, 1.0, -2.0][k];
+        let radial = Vector3::new(angle.cos(), angle.sin(), 0.0);
+        let p = centre + radial * (circle + d) + Vector3::new(0.0, 0.0, 2.0);
+        let foot = distance.foot_in_section(&p).unwrap();
+        assert!((foot.distance_mm - d).abs() < 1e-9, "{d}: {foot:?}");
+        assert!((foot.point.z - 13.0).abs() < 1e-12);
+        assert!((foot.normal - radial).norm() < 1e-9);
+        assert!(solid.value(&foot.point).abs() < 1e-12);
+        // Out of the plane the surface comes nearer: the 3-D distance is not the section's.
+        let across = distance.foot(&p).unwrap().distance_mm;
+        assert!((across - ((circle + d).hypot(2.0) - 7.5)).abs() < 1e-9);
+        assert!((across - d).abs() > 0.02 * d.abs());
+    }
+}
+
+#[test]
+fn a_section_of_a_union_meets_the_crease_where_it_pierces_the_plane() {
+    // The two balls of radius 5 at x = -3 and 3 cut by z = 0.3: two circles of radius
+    // sqrt(25 - 0.09) meeting at x = 0, y = +-sqrt(25 - 0.09 - 9).
+    let union = Node::boolean(
+        Boolean::Union,
+        RFunction::P(2),
+        sphere(
+            5.0,
+            vec![Deformation::Rigid(Isometry3::translation(-3.0, 0.0, 0.0))],
+        ),
+        sphere(
+            5.0,
+            vec![Deformation::Rigid(Isometry3::translation(3.0, 0.0, 0.0))],
+        ),
+    );
+    let solid = Solid::new(union);
+    let distance = SolidDistance::new(&solid);
+    let z = 0.3;
+    let radius = (25.0f64 - z * z).sqrt();
+    let crease = (radius * radius - 9.0).sqrt();
+    let centres = [Point3::new(-3.0, 0.0, z), Point3::new(3.0, 0.0, z)];
+    for side in [1.0, -1.0] {
+        for x in [0.0, 0.2] {
+            for t in [0.001, 0.1, 0.5] {
+                let p = Point3::new(x, side * (crease - t), z);
+                let mut expected = x.hypot(t);
+                for (k, centre) in centres.iter().enumerate() {
+                    let foot = centre + (p - centre).normalize() * radius;
+                    if (foot - centres[1 - k]).norm() >= radius {
+                        expected = expected.min(radius - (p - centre).norm());
+                    }
+                }
+                let foot = distance.foot_in_section(&p).unwrap();
+                assert!(
+                    (foot.distance_mm + expected).abs() < 1e-9,
+                    "{p}: {} vs {}",
+                    foot.distance_mm,
+                    -expected
+                );
+                assert!((foot.point.z - z).abs() < 1e-12 && foot.normal.z.abs() < 1e-12);
+                if x == 0.0 {
+                    assert_eq!(foot.kind, FootKind::Edge);
+                }
+                assert!(solid.value(&foot.point).abs() < 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn around_a_hex_nut_no_boundary_sample_is_nearer_than_the_foot() {
+    // Points anywhere round the nut, near and far from faces, edges and the bore: the exact
+    // distance can exceed the distance to no boundary point, and falls short of the nearest of
+    // a fine independent sampling by at most that sampling's gap.
+    let (solid, _, _, _) = hex_nut();
+    let distance = SolidDistance::new(&solid);
+    let fine = SolidDistance::with_spacing(&solid, 0.15);
+    assert!(fine.samples.gap < 0.5 * distance.samples.gap);
+    let bounds = solid.bounds();
+    let span = bounds.max - bounds.min;
+    let mut below = 0;
+    for i in 0..300 {
+        let u = Vector3::new(
+            (i as f64 * 0.618_034).fract(),
+            (i as f64 * 0.754_878).fract(),
+            (i as f64 * 0.569_840).fract(),
+        );
+        let p = bounds.min - span * 0.1 + span.component_mul(&u) * 1.2;
+        let foot = distance.foot(&p).expect("a foot");
+        check_foot(&solid, &p, &foot);
+        assert_eq!(foot.distance_mm > 0.0, !solid.contains(&p), "{p}");
+        let nearest_sample = fine
+            .samples
+            .tree
+            .nearest_neighbor([p.x, p.y, p.z])
+            .map(|s| (Point3::from(s.point) - p).norm())
+            .unwrap();
+        let exact = foot.distance_mm.abs();
+        assert!(
+            exact <= nearest_sample + 1e-9,
+            "{p}: {exact} > {nearest_sample}"
+        );
+        assert!(
+            exact >= nearest_sample - fine.samples.gap,
+            "{p}: {exact} vs {nearest_sample}"
+        );
+        below += usize::from(exact < nearest_sample - 1e-6);
+    }
+    // The samples are only near the foot: most exact distances are strictly below them.
+    assert!(below > 250, "{below}");
+}
+
+#[test]
+fn where_a_box_edge_pierces_a_ball_the_vertex_is_nearest() {
+    // A ball of radius 10 cut to the square prism |x|, |y| <= 5: the prism's edge x = y = 5 leaves
+    // the ball at the vertex (5, 5, sqrt 50), where the faces x = 5, y = 5 and the sphere meet.
+    let mut cut = Node::boolean(
+        Boolean::Intersection,
+        RFunction::P(2),
+        sphere(10.0, vec![]),
+        Node::cuboid([5.0, 5.0, 20.0], Deformations::default()),
+    );
+    cut.place = Deformations(vec![pose()]);
+    let solid = Solid::new(cut);
+    let distance = SolidDistance::new(&solid);
+    let vertex = Point3::new(5.0, 5.0, 50f64.sqrt());
+    let ball_normal = vertex.coords / 10.0;
+    for (a, b, c) in [(1.0, 1.0, 1.0), (0.2, 1.0, 0.5), (1.0, 0.3, 2.0)] {
+        // Any positive combination of the three normals is in the vertex's normal cone.
+        let direction = (Vector3::x() * a + Vector3::y() * b + ball_normal * c).normalize();
+        for t in [0.001, 0.3, 2.0] {
+            let p = pose().apply(&(vertex + direction * t));
+            let foot = distance.foot(&p).unwrap();
+            assert!((foot.distance_mm - t).abs() < 1e-9, "{t}: {foot:?}");
+            assert_eq!(foot.kind, FootKind::Vertex);
+            assert!((foot.point - pose().apply(&vertex)).norm() < 1e-9);
+            check_foot(&solid, &p, &foot);
+        }
+    }
+}
