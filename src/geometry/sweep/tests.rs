@@ -155,9 +155,53 @@ fn sweep_mesh_distances_are_exact_and_signed() {
     )
     .unwrap();
     assert!(!open.is_signed());
+    // Inverted triangles are refused rather than read with every sign turned.
+    let inverted: Vec<[usize; 3]> = (0..cube.triangle_count())
+        .map(|i| {
+            let [a, b, c] = cube.triangle(i);
+            [a, c, b]
+        })
+        .collect();
+    assert!(matches!(
+        MeshPart::new(cube.vertices().to_vec(), inverted, 0.0),
+        Err(super::mesh::MeshError::InsideOut(v)) if (v + 1000.0).abs() < 1e-9
+    ));
     // The chord tolerance is subtracted.
     let coarse = MeshPart::new(cube.vertices().to_vec(), vec![[0, 2, 1], [0, 3, 2]], 0.25).unwrap();
     close(coarse.distance(&p(50.0, 0.0, -8.0)), 2.75);
+}
+
+#[test]
+fn sweep_mesh_segment_search_agrees_with_brute_force() {
+    let wedge = trailing_edge();
+    let mut seed = 11u64;
+    let mut rand = |lo: f64, hi: f64| {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        lo + (hi - lo) * ((seed >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    for _ in 0..200 {
+        let a = p(rand(-5.0, 25.0), rand(-6.0, 6.0), rand(-3.0, 13.0));
+        let b = p(rand(-5.0, 25.0), rand(-6.0, 6.0), rand(-3.0, 13.0));
+        let brute = (0..wedge.triangle_count())
+            .map(|i| {
+                let [t0, t1, t2] = wedge.triangle(i).map(|k| wedge.vertices()[k]);
+                let (s, q) = super::closest::closest_segment_triangle(&a, &b, [&t0, &t1, &t2]);
+                (s - q).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let found = wedge.segment_proximity(&a, &b);
+        assert!(
+            (found.distance_mm.abs() - brute).abs() < 1e-12,
+            "{} vs {brute}",
+            found.distance_mm
+        );
+        let sign_of_a = wedge.distance(&a).signum();
+        if brute > 0.0 {
+            assert_eq!(found.distance_mm.signum(), sign_of_a);
+        }
+    }
 }
 
 #[test]
