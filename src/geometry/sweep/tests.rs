@@ -561,6 +561,31 @@ fn sweep_silhouette_of_a_ball_on_a_line_is_the_capsule_outline() {
     let svg = silhouette_svg(&components, &view, 400.0);
     assert_eq!(svg.matches("<g ").count(), 1);
     assert_eq!(svg.matches("<polyline").count(), 4);
+    // The drawing fills the picture less its 5 % margins along its longer (horizontal) side, centred.
+    let coords: Vec<(f64, f64)> = svg
+        .split("points=\"")
+        .skip(1)
+        .flat_map(|rest| rest.split('"').next().unwrap().split(' '))
+        .map(|pair| {
+            let (x, y) = pair.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    let (x_min, x_max) = coords
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+            (a.min(c.0), b.max(c.0))
+        });
+    let (y_min, y_max) = coords
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+            (a.min(c.1), b.max(c.1))
+        });
+    assert!(
+        (x_min - 20.0).abs() < 2e-3 && (x_max - 380.0).abs() < 2e-3,
+        "{x_min} {x_max}"
+    );
+    assert!((0.5 * (y_min + y_max) - 200.0).abs() < 2e-3 && y_max - y_min < 360.0);
 }
 
 #[test]
