@@ -42,6 +42,8 @@ fn section(z: f64) -> Vec<Vector2<f64>> {
         pts.push(Vector2::new(x, naca_half_thickness(x, 0.12)));
     }
     pts.dedup_by(|a, b| (*a - *b).norm() < 1e-12);
+    // Lower surface to the left, upper to the right is clockwise: reverse for outward-facing triangles.
+    pts.reverse();
     pts.into_iter()
         .map(|p| {
             let q = (p - Vector2::new(0.5, 0.0)) * CHORD;
@@ -85,7 +87,8 @@ fn blade() -> MeshPart {
     MeshPart::new(vertices, triangles, 0.0).expect("the blade mesh is valid")
 }
 
-/// Around the blade at several heights: an ellipse of line moves, an arc around the leading edge, and
+/// Around the blade at several heights (the shank reaching up past the twisted sections above): an ellipse of
+/// line moves, an arc around the leading edge, and
 /// approach / retract moves to 3 mm from the surface along the section's normal.
 fn plan(stylus: &Stylus) -> Vec<Motion> {
     let clear = stylus.ball_radius_mm + 3.0;
@@ -96,8 +99,8 @@ fn plan(stylus: &Stylus) -> Vec<Motion> {
             .map(|i| {
                 let a = TAU * i as f64 / 16.0;
                 Point3::new(
-                    (0.5 * CHORD + 6.0) * a.cos(),
-                    (0.06 * CHORD + 5.0) * a.sin(),
+                    (0.5 * CHORD + 8.0) * a.cos(),
+                    (0.06 * CHORD + 12.0) * a.sin(),
                     z,
                 )
             })
@@ -107,7 +110,7 @@ fn plan(stylus: &Stylus) -> Vec<Motion> {
             Motion::arc(
                 Point3::new(-20.0, 0.0, z),
                 Vector3::z(),
-                Point3::new(-20.0, -12.0, z),
+                Point3::new(-20.0, -16.0, z),
                 -3.0,
             )
             .expect("arc off its axis"),
@@ -128,7 +131,7 @@ fn plan(stylus: &Stylus) -> Vec<Motion> {
 
 fn clearance(c: &mut Criterion) {
     let part = blade();
-    let stylus = Stylus::new(1.5, 0.75, 40.0).expect("stylus");
+    let stylus = Stylus::new(1.5, 0.75, 20.0).expect("stylus");
     let moves = plan(&stylus);
     let margin = 0.5;
     let accepted = check_plan(&stylus, &moves, &part, margin).expect("the plan keeps its margin");

@@ -1,15 +1,16 @@
 //! A triangle mesh as a part model: exact point-triangle and segment-triangle distances over an R*-tree of the
-//! triangles' bounding boxes, signed by angle-weighted pseudo-normals (Baerentsen and Aanaes, "Signed distance
+//! triangles' bounding boxes (nearest-neighbour and best-first searches), signed by angle-weighted pseudo-normals (Baerentsen and Aanaes, "Signed distance
 //! computation using the angle weighted pseudonormal", 2005) when the mesh is closed.
 //!
 //! The mesh approximates the true part: the chord tolerance (the largest distance between the tessellation and the
 //! surface it stands for, as the CAD exporter was asked for) is subtracted from every distance, so that what this
 //! model reports is a lower bound of the distance to the true surface too.
 
-use std::collections::HashMap;
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap};
 
 use nalgebra::{Point3, Vector3};
-use rstar::{PointDistance, RTree, RTreeObject, AABB};
+use rstar::{PointDistance, RTree, RTreeNode, RTreeObject, AABB};
 
 use super::closest::{closest_on_triangle, closest_segment_triangle, TriangleFeature};
 use super::part::{PartDistance, Proximity};
@@ -20,6 +21,8 @@ pub enum MeshError {
     Empty,
     #[error("triangle {0} refers to vertex {1}, but the mesh has {2} vertices")]
     BadIndex(usize, usize, usize),
+    #[error("the closed mesh encloses a negative volume ({0} mm^3): its triangles face inwards; reverse them")]
+    InsideOut(f64),
     #[error("the chord tolerance must be finite and non-negative, got {0} mm")]
     BadChordTolerance(f64),
 }
@@ -46,6 +49,66 @@ impl PointDistance for IndexedTriangle {
         let p = Point3::from(*point);
         let [a, b, c] = &self.corners;
         (closest_on_triangle(&p, a, b, c).0 - p).norm_squared()
+    }
+}
+
+/// Lower bounds of the distance from a segment to a box: the gap between the box and the segment's own box, and
+/// the distance from the box to the segment's midpoint less half its length; the larger of the two.
+struct SegmentBounds {
+    lo: Point3<f64>,
+    hi: Point3<f64>,
+    mid: [f64; 3],
+    half_length: f64,
+}
+
+impl SegmentBounds {
+    fn new(a: &Point3<f64>, b: &Point3<f64>) -> Self {
+        Self {
+            lo: a.inf(b),
+            hi: a.sup(b),
+            mid: nalgebra::center(a, b).coords.into(),
+            half_length: 0.5 * (b - a).norm(),
+        }
+    }
+
+    fn lower_bound(&self, envelope: &AABB<[f64; 3]>) -> f64 {
+        let (lo, hi) = (envelope.lower(), envelope.upper());
+        let gap: f64 = (0..3)
+            .map(|k| {
+                (lo[k] - self.hi[k])
+                    .max(self.lo[k] - hi[k])
+                    .max(0.0)
+                    .powi(2)
+            })
+            .sum();
+        let from_mid = envelope.distance_2(&self.mid).sqrt() - self.half_length;
+        gap.sqrt().max(from_mid)
+    }
+}
+
+/// A node of the search queue, ordered so that the smallest bound comes out first.
+struct Candidate<'a> {
+    bound: f64,
+    node: &'a RTreeNode<IndexedTriangle>,
+}
+
+impl PartialEq for Candidate<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        self.bound.total_cmp(&other.bound) == Ordering::Equal
+    }
+}
+
+impl Eq for Candidate<'_> {}
+
+impl PartialOrd for Candidate<'_> {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Candidate<'_> {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.bound.total_cmp(&self.bound)
     }
 }
 
@@ -139,6 +202,22 @@ impl MeshPart {
             })
             .collect();
         let pseudo_normals = PseudoNormals::of_closed(&vertices, &triangles);
+        if pseudo_normals.is_some() {
+            // Divergence theorem: a closed mesh with outward triangles encloses a positive volume; an inverted one
+            // would turn every sign (inside taken for outside) and blind the clearance check.
+            let volume: f64 = triangles
+                .iter()
+                .map(|t| {
+                    vertices[t[0]]
+                        .coords
+                        .dot(&vertices[t[1]].coords.cross(&vertices[t[2]].coords))
+                        / 6.0
+                })
+                .sum();
+            if volume < 0.0 {
+                return Err(MeshError::InsideOut(volume));
+            }
+        }
         Ok(Self {
             vertices,
             triangles,
@@ -155,6 +234,11 @@ impl MeshPart {
 
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
+    }
+
+    /// Vertex indices of triangle i.
+    pub fn triangle(&self, i: usize) -> [usize; 3] {
+        self.triangles[i]
     }
 
     pub fn chord_tolerance_mm(&self) -> f64 {
@@ -201,27 +285,42 @@ impl PartDistance for MeshPart {
         }
     }
 
-    /// The nearer end bounds the segment's distance from above, so only triangles whose boxes meet the
-    /// segment's box grown by that bound can hold the minimum; those are measured exactly.
+    /// Best-first search of the R*-tree: nodes in order of a lower bound of their distance to the segment, exact
+    /// segment-triangle distances at the leaves, until no node can hold anything nearer than the best found.
     fn segment_proximity(&self, a: &Point3<f64>, b: &Point3<f64>) -> Proximity {
-        let (da, qa) = self.exact_point(a);
-        let (db, qb) = self.exact_point(b);
-        let (mut best_d, mut best) = if da.abs() <= db.abs() {
-            (da.abs(), (*a, qa))
-        } else {
-            (db.abs(), (*b, qb))
-        };
-        let grow = Vector3::repeat(best_d);
-        let lo = a.inf(b) - grow;
-        let hi = a.sup(b) + grow;
-        let search = AABB::from_corners(lo.coords.into(), hi.coords.into());
-        for tri in self.tree.locate_in_envelope_intersecting(search) {
-            let [t0, t1, t2] = &tri.corners;
-            let (s, q) = closest_segment_triangle(a, b, [t0, t1, t2]);
-            let d = (s - q).norm();
-            if d < best_d {
-                best_d = d;
-                best = (s, q);
+        let (da, _) = self.exact_point(a);
+        let bounds = SegmentBounds::new(a, b);
+        let mut best_d = f64::INFINITY;
+        let mut best = (*a, *a);
+        let mut queue = BinaryHeap::new();
+        for child in self.tree.root().children() {
+            queue.push(Candidate {
+                bound: bounds.lower_bound(&child.envelope()),
+                node: child,
+            });
+        }
+        while let Some(Candidate { bound, node }) = queue.pop() {
+            if bound >= best_d {
+                break;
+            }
+            match node {
+                RTreeNode::Leaf(tri) => {
+                    let [t0, t1, t2] = &tri.corners;
+                    let (s, q) = closest_segment_triangle(a, b, [t0, t1, t2]);
+                    let d = (s - q).norm();
+                    if d < best_d {
+                        best_d = d;
+                        best = (s, q);
+                    }
+                }
+                RTreeNode::Parent(parent) => {
+                    for child in parent.children() {
+                        let bound = bounds.lower_bound(&child.envelope());
+                        if bound < best_d {
+                            queue.push(Candidate { bound, node: child });
+                        }
+                    }
+                }
             }
         }
         // A segment that does not meet the surface lies wholly on one side of it: the side of its end a.

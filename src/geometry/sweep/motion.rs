@@ -24,6 +24,8 @@ pub enum MotionError {
     ZeroLength,
     #[error("the arc's start lies on its axis (zero radius)")]
     ZeroRadius,
+    #[error("the arc's axis must be a non-zero vector")]
+    ZeroAxis,
 }
 
 impl ScanPath {
@@ -137,7 +139,7 @@ impl Motion {
         start: Point3<f64>,
         angle_rad: f64,
     ) -> Result<Self, MotionError> {
-        let axis = Unit::new_normalize(axis);
+        let axis = Unit::try_new(axis, 1e-12).ok_or(MotionError::ZeroAxis)?;
         if distance_from_axis(&start, &centre, &axis) == 0.0 {
             return Err(MotionError::ZeroRadius);
         }

@@ -5,8 +5,8 @@ use nalgebra::Point3;
 /// The nearest approach between a query (a point or a segment) and the part.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Proximity {
-    /// A lower bound of the Euclidean distance to the part's surface (mm), negative when the query reaches inside
-    /// the material.
+    /// A lower bound of the Euclidean distance to the part's surface (mm); zero or negative when the query meets
+    /// the material (a conservative implementation may report it negative a little early).
     pub distance_mm: f64,
     /// The point of the query (the point itself, or a point of the segment) nearest the part.
     pub query_point: Point3<f64>,
@@ -20,7 +20,7 @@ pub trait PartDistance {
     /// Proximity of a point.
     fn point_proximity(&self, p: &Point3<f64>) -> Proximity;
 
-    /// Proximity of the segment [a, b]; negative distance when any of it is inside the material.
+    /// Proximity of the segment [a, b]: zero when it crosses the surface, negative when it lies wholly inside.
     fn segment_proximity(&self, a: &Point3<f64>, b: &Point3<f64>) -> Proximity;
 
     /// A lower bound of the Euclidean distance from p to the part surface, negative inside.

@@ -395,6 +395,9 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
     let extent = (hi.0 - lo.0).max(hi.1 - lo.1).max(f64::MIN_POSITIVE);
     let margin = 0.05 * size_px;
     let scale = (size_px - 2.0 * margin) / extent;
+    // Centred in both directions: the shorter side gets the extra room.
+    let left = margin + 0.5 * (extent - (hi.0 - lo.0)) * scale;
+    let bottom = margin + 0.5 * (extent - (hi.1 - lo.1)) * scale;
     let mut svg = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{size_px}\" height=\"{size_px}\" viewBox=\"0 0 {size_px} {size_px}\">\n"
     );
@@ -414,8 +417,8 @@ pub fn silhouette_svg(components: &[SilhouetteComponent], view: &View, size_px: 
                 .map(|(x, y)| {
                     format!(
                         "{:.3},{:.3}",
-                        margin + (x - lo.0) * scale,
-                        size_px - margin - (y - lo.1) * scale
+                        left + (x - lo.0) * scale,
+                        size_px - bottom - (y - lo.1) * scale
                     )
                 })
                 .collect();

@@ -155,9 +155,53 @@ fn sweep_mesh_distances_are_exact_and_signed() {
     )
     .unwrap();
     assert!(!open.is_signed());
+    // Inverted triangles are refused rather than read with every sign turned.
+    let inverted: Vec<[usize; 3]> = (0..cube.triangle_count())
+        .map(|i| {
+            let [a, b, c] = cube.triangle(i);
+            [a, c, b]
+        })
+        .collect();
+    assert!(matches!(
+        MeshPart::new(cube.vertices().to_vec(), inverted, 0.0),
+        Err(super::mesh::MeshError::InsideOut(v)) if (v + 1000.0).abs() < 1e-9
+    ));
     // The chord tolerance is subtracted.
     let coarse = MeshPart::new(cube.vertices().to_vec(), vec![[0, 2, 1], [0, 3, 2]], 0.25).unwrap();
     close(coarse.distance(&p(50.0, 0.0, -8.0)), 2.75);
+}
+
+#[test]
+fn sweep_mesh_segment_search_agrees_with_brute_force() {
+    let wedge = trailing_edge();
+    let mut seed = 11u64;
+    let mut rand = |lo: f64, hi: f64| {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        lo + (hi - lo) * ((seed >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    for _ in 0..200 {
+        let a = p(rand(-5.0, 25.0), rand(-6.0, 6.0), rand(-3.0, 13.0));
+        let b = p(rand(-5.0, 25.0), rand(-6.0, 6.0), rand(-3.0, 13.0));
+        let brute = (0..wedge.triangle_count())
+            .map(|i| {
+                let [t0, t1, t2] = wedge.triangle(i).map(|k| wedge.vertices()[k]);
+                let (s, q) = super::closest::closest_segment_triangle(&a, &b, [&t0, &t1, &t2]);
+                (s - q).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let found = wedge.segment_proximity(&a, &b);
+        assert!(
+            (found.distance_mm.abs() - brute).abs() < 1e-12,
+            "{} vs {brute}",
+            found.distance_mm
+        );
+        let sign_of_a = wedge.distance(&a).signum();
+        if brute > 0.0 {
+            assert_eq!(found.distance_mm.signum(), sign_of_a);
+        }
+    }
 }
 
 #[test]
@@ -517,6 +561,31 @@ fn sweep_silhouette_of_a_ball_on_a_line_is_the_capsule_outline() {
     let svg = silhouette_svg(&components, &view, 400.0);
     assert_eq!(svg.matches("<g ").count(), 1);
     assert_eq!(svg.matches("<polyline").count(), 4);
+    // The drawing fills the picture less its 5 % margins along its longer (horizontal) side, centred.
+    let coords: Vec<(f64, f64)> = svg
+        .split("points=\"")
+        .skip(1)
+        .flat_map(|rest| rest.split('"').next().unwrap().split(' '))
+        .map(|pair| {
+            let (x, y) = pair.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    let (x_min, x_max) = coords
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+            (a.min(c.0), b.max(c.0))
+        });
+    let (y_min, y_max) = coords
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+            (a.min(c.1), b.max(c.1))
+        });
+    assert!(
+        (x_min - 20.0).abs() < 2e-3 && (x_max - 380.0).abs() < 2e-3,
+        "{x_min} {x_max}"
+    );
+    assert!((0.5 * (y_min + y_max) - 200.0).abs() < 2e-3 && y_max - y_min < 360.0);
 }
 
 #[test]
