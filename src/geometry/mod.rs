@@ -12,4 +12,5 @@ pub mod published;
 pub mod sampling;
 pub mod small;
 pub mod supershape;
+pub mod sweep;
 pub mod trace;
