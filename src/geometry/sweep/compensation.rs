@@ -220,16 +220,20 @@ impl Compensator {
         Some(self.fitted(index - LOOK_AHEAD, &window))
     }
 
-    /// The points still waiting for their look-ahead: the path's end, along the reported normals.
-    pub fn finish(self) -> Vec<Compensated> {
+    /// Ends the path: returns the points still waiting for their look-ahead (the path's end, along the reported
+    /// normals). The next point pushed starts a new path.
+    pub fn finish(&mut self) -> Vec<Compensated> {
         let first_waiting = self.received.saturating_sub(LOOK_AHEAD).max(LOOK_AHEAD);
         let buffered_from = self.received - self.recent.len();
-        (first_waiting..self.received)
+        let rest = (first_waiting..self.received)
             .map(|index| {
                 let sample = self.recent[index - buffered_from];
                 self.reported(index, &sample, Method::Reported(Fallback::PathEnd))
             })
-            .collect()
+            .collect();
+        self.recent.clear();
+        self.received = 0;
+        rest
     }
 
     fn sample(&self, centre: Point3<f64>, reported_normal: Vector3<f64>) -> Sample {
