@@ -164,7 +164,7 @@ fn deviations_csv_has_a_header_with_units_and_one_row_per_point() {
         .expect("the row of blade-B p300 point 0");
     assert_eq!(
         *row,
-        "blade-B,p300,0,300.000000,40.000000,0.000000,0.110000,0.000000,1"
+        "blade-B,p300,0,300.000000,40.000000,0.000000,0.110000,0.000000,1,0"
     );
 }
 

@@ -266,10 +266,19 @@ mod tests {
 
     const BALL: f64 = 1.0;
 
+    /// A point event's fields the tests look at.
+    struct PointEvent {
+        index: usize,
+        surface: [f64; 3],
+        deviation: Option<f64>,
+        flagged: bool,
+        received: u64,
+    }
+
     /// What the pipeline published for one scan.
     struct Published {
-        /// (index, surface, deviation, flagged, received_unix_us) in the order published.
-        points: Vec<(usize, [f64; 3], Option<f64>, bool, u64)>,
+        /// In the order published.
+        points: Vec<PointEvent>,
         stats: Option<DeviationStats>,
     }
 
@@ -347,13 +356,13 @@ mod tests {
                     flagged,
                     received_unix_us,
                     ..
-                } => published.points.push((
+                } => published.points.push(PointEvent {
                     index,
-                    surface_mm,
-                    deviation_mm,
+                    surface: surface_mm,
+                    deviation: deviation_mm,
                     flagged,
-                    received_unix_us,
-                )),
+                    received: received_unix_us,
+                }),
                 Event::ProfileDone { stats, .. } => {
                     published.stats = stats;
                     break;
@@ -397,15 +406,18 @@ mod tests {
             key,
         })
         .await;
-        let indices: Vec<usize> = published.points.iter().map(|p| p.0).collect();
+        let indices: Vec<usize> = published.points.iter().map(|p| p.index).collect();
         assert_eq!(indices, (0..raws.len()).collect::<Vec<_>>());
         // Each event carries its own point's arrival, not that of the point that completed its look-ahead.
-        assert!(published.points.iter().all(|p| p.4 == 1000 + p.0 as u64));
+        assert!(published
+            .points
+            .iter()
+            .all(|p| p.received == 1000 + p.index as u64));
         let flagged: Vec<usize> = published
             .points
             .iter()
-            .filter(|p| p.3)
-            .map(|p| p.0)
+            .filter(|p| p.flagged)
+            .map(|p| p.index)
             .collect();
         assert!(!flagged.is_empty());
         assert!(
@@ -416,12 +428,12 @@ mod tests {
         );
         // The dent's bottom is flagged, and still published with its deviation.
         assert!(flagged.contains(&150));
-        assert!(published.points[150].2.is_some());
+        assert!(published.points[150].deviation.is_some());
         let stats = published.stats.expect("inspect statistics");
         let counted = published
             .points
             .iter()
-            .filter(|p| !p.3 && p.2.is_some())
+            .filter(|p| !p.flagged && p.deviation.is_some())
             .count();
         assert_eq!(stats.points, counted);
         assert_eq!(stats.points + flagged.len(), raws.len());
@@ -429,8 +441,10 @@ mod tests {
         let off_dent = published
             .points
             .iter()
-            .filter(|p| p.0.abs_diff(150) > 3 + crate::geometry::sweep::compensation::LOOK_AHEAD)
-            .map(|p| p.2.unwrap().abs())
+            .filter(|p| {
+                p.index.abs_diff(150) > 3 + crate::geometry::sweep::compensation::LOOK_AHEAD
+            })
+            .map(|p| p.deviation.unwrap().abs())
             .fold(0.0, f64::max);
         assert!(off_dent < 0.01, "{off_dent}");
     }
@@ -439,14 +453,14 @@ mod tests {
     async fn sweep_points_waiting_for_their_look_ahead_are_published_when_a_scan_is_cut() {
         let raws = dented_ellipse_scan();
         let published = run(2, None, &raws[..6], |key| PipelineMsg::Cut { key }).await;
-        let indices: Vec<usize> = published.points.iter().map(|p| p.0).collect();
+        let indices: Vec<usize> = published.points.iter().map(|p| p.index).collect();
         assert_eq!(indices, (0..6).collect::<Vec<_>>());
         // Teaching: no deviations; the surface is the centre one ball radius in along the normal.
-        for (index, surface, deviation, flagged, _) in &published.points {
-            assert!(deviation.is_none() && !flagged);
-            let raw = raws[*index];
+        for point in &published.points {
+            assert!(point.deviation.is_none() && !point.flagged);
+            let raw = raws[point.index];
             let expected = Point3::from(raw.centre) - Vector3::from(raw.normal) * BALL;
-            assert!((Point3::from(*surface) - expected).norm() < 1e-12);
+            assert!((Point3::from(point.surface) - expected).norm() < 1e-12);
         }
     }
 }

@@ -441,6 +441,8 @@ fn streaming_gives_the_batch_result_with_a_look_ahead_of_four_points() {
     streamed.extend(compensator.finish());
     assert_eq!(streamed, batch);
     assert_eq!(streamed.len(), path.len());
+    // After `finish` the next point starts a new path.
+    assert_eq!(compensator.push(path[0].0, path[0].1).unwrap().index, 0);
     assert!(streamed[..LOOK_AHEAD]
         .iter()
         .chain(&streamed[path.len() - LOOK_AHEAD..])
