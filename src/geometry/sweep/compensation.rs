@@ -33,12 +33,13 @@
 //! flag says their contact is not to be trusted.
 //!
 //! The local fit: at each point, a least-squares quartic `y(x)` through the 2 K + 1 = 9 centres around it, in a frame
-//! along the central-difference chord. Why a quartic over nine: the contact error is `r` times the normal's angle
-//! error, so 0.01 um with a 1 mm ball asks for 1e-5 rad. A parabola's normal is off by a term in `y''' h^2`, which
-//! misses that by an order of magnitude on an airfoil's nose at 0.2 mm spacing; the quartic's next term is
-//! `y^(5) h^4`. Nine points leave four degrees of freedom, so 2 um noise is averaged (the slope's noise is about
-//! `sigma / h / 3`) and the fit's residual tells a window the quartic cannot follow (a corner, sampling too coarse for
-//! the curvature) from noise. Such a window, bending convexly, falls back to the reported normal (sound there: the
+//! along the central-difference chord (a moving least-squares fit, not an interpolation, so noise is averaged). Why
+//! a quartic over nine: the contact error is `r` times the normal's angle error, so 0.01 um with a 1 mm ball asks
+//! for 1e-5 rad. A parabola's slope at the point is off by a term in `y''' h^2`, the quartic's by one in
+//! `y^(5) h^4`. The price is noise: with 2 um on each centre the quartic's slope has a standard deviation of
+//! 0.34 sigma / h (a parabola's 0.13 sigma / h), which moves the contact along the surface by `r` times that but
+//! off it only by `r` times its square over two. Nine points leave four degrees of freedom, so the fit's residual
+//! tells a window the quartic cannot follow (a corner, sampling too coarse for the curvature) from noise. Such a window, bending convexly, falls back to the reported normal (sound there: the
 //! ball rolls round an edge and the machine's normal points at it); bending concavely, it is flagged as a cusp.
 //!
 //! The tilt (3-D case): a section scan keeps the ball centre in the plane, but where the surface leans along the
@@ -94,11 +95,11 @@ pub struct CompensationSettings {
 impl CompensationSettings {
     /// Defaults for a ball of `ball_radius_mm` on a machine of 2 um noise.
     ///
-    /// `concave_margin` 0.2: a fitted window smooths a centre-path corner into a bend of radius about its half-width
-    /// (0.3 mm at 0.1 mm spacing); with a 1 mm ball that is `1 - r kappa_s = 0.3 / 1.3`, so a margin of 0.2 catches
-    /// corners from about 0.1 mm spacing and finer, and still passes concave fillets 1.25 times the ball's radius.
-    /// `convex_tolerance` 0.25: a path round a sharp edge, fitted with 2 um noise at 0.1 mm spacing, stays within
-    /// 0.1 of `1 + r kappa_c = 0`.
+    /// `concave_margin` 0.2 flags surfaces whose concave radius is within 1.25 times the ball's and passes wider
+    /// fillets (a 2 mm bore with a 1 mm ball, `1 - r kappa_s = 0.5`, is fitted exactly). A sharper corner, which
+    /// the fit smooths over its window, shows as a residual the quartic cannot explain ([`Cusp::UnresolvedConcave`]).
+    /// `convex_tolerance` 0.25: a ball rolling round a sharp edge (`1 + r kappa_c = 0`) with 2 um noise at 0.1 mm
+    /// spacing stays inside it (the rolling-edge test).
     pub fn new(ball_radius_mm: f64) -> Self {
         CompensationSettings {
             ball_radius_mm,
