@@ -36,7 +36,8 @@
 //! along the central-difference chord (a moving least-squares fit, not an interpolation, so noise is averaged). Why
 //! a quartic over nine: the contact error is `r` times the normal's angle error, so 0.01 um with a 1 mm ball asks
 //! for 1e-5 rad. A parabola's slope at the point is off by a term in `y''' h^2`, the quartic's by one in
-//! `y^(5) h^4`. The price is noise: with 2 um on each centre the quartic's slope has a standard deviation of
+//! `y^(5) h^4`: fitted by parabolas, the noise-free ellipse and NACA 0012 of the tests are off by 0.45 um and
+//! 0.27 um, by quartics less than 0.01 um. The price is noise: with 2 um on each centre the quartic's slope has a standard deviation of
 //! 0.34 sigma / h (a parabola's 0.13 sigma / h), which moves the contact along the surface by `r` times that but
 //! off it only by `r` times its square over two. Nine points leave four degrees of freedom, so the fit's residual
 //! tells a window the quartic cannot follow (a corner, sampling too coarse for the curvature) from noise. Such a window, bending convexly, falls back to the reported normal (sound there: the
