@@ -44,6 +44,7 @@ fn profile(blade: usize, x: f64, shift: f64) -> ProfileReport {
                 deviation_mm,
                 off_plane_mm: 0.0,
                 quality: 0.0,
+                flagged: false,
             }
         })
         .collect();

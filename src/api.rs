@@ -134,6 +134,10 @@ pub enum Event {
         surface_mm: [f64; 3],
         /// Signed deviation from the reference (mm, positive outside the material); `None` when teaching.
         deviation_mm: Option<f64>,
+        /// Compensation flagged the point's contact as not unique (a cusp: the surface more concave than the
+        /// ball): kept, but left out of the statistics. Absent (false) from older daemons.
+        #[serde(default)]
+        flagged: bool,
         /// When the point's line arrived from the machine, microseconds since the Unix epoch.
         received_unix_us: u64,
     },
@@ -330,6 +334,7 @@ mod tests {
             index: 7,
             surface_mm: [300.0, 1.5, -2.25],
             deviation_mm: Some(-0.4125),
+            flagged: true,
             received_unix_us: 1_700_000_000_000_000,
         });
         let line = to_line(&event);

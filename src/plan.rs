@@ -126,6 +126,12 @@ impl Plan {
         self.placements[instance]
     }
 
+    /// The normal of instance `instance`'s section planes (the part frame's x axis) in machine coordinates: the
+    /// plane a profile's ball centres lie in, into which compensation slides the contacts.
+    pub fn plane_normal(&self, instance: usize) -> Vector3<f64> {
+        self.instance_to_machine(instance) * Vector3::x()
+    }
+
     /// A point in machine coordinates where the profile's scan starts (for ordering scans to cut travel):
     /// the first point of its curve scan when the taught nominals are given, else the drawing's start.
     pub fn scan_start(&self, key: ProfileKey, nominals: Option<&[NominalPoint]>) -> Point3<f64> {
@@ -152,7 +158,7 @@ impl Plan {
         InPlaneScan {
             start: point(start),
             start_normal: direction(normal),
-            plane_normal: direction(Vector3::x()),
+            plane_normal: xyz(&self.plane_normal(key.instance)),
             direction: point(start + heading * HEADING_POINT_MM),
             step: self.part.scan.step_mm,
             end: point(start + normal * STOP_CENTRE_OFF_START_MM),

@@ -11,10 +11,12 @@ pub mod part_mesh;
 pub mod reference;
 pub mod stats;
 #[cfg(test)]
-mod test_profiles;
+pub(crate) mod test_profiles;
 
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
+
+use crate::geometry::sweep::compensation::{compensate_path, Compensated, CompensationSettings};
 
 pub use deviation::{PointDeviation, ProfileGauge, ScanGauge};
 pub use reference::{
@@ -31,7 +33,32 @@ pub struct RawPoint {
     pub quality: f64,
 }
 
-/// The surface point a CMM's ball touched: the centre moved back one ball radius along the normal.
+/// A scan's points compensated for the probe ball exactly as the pipeline compensates them live (so that a report
+/// and a taught reference agree with the events): from the ball-centre path, in planes of normal `plane_normal`,
+/// the reported normal only at the scan's first and last points and where the path cannot be fitted; points whose
+/// contact is flagged (a cusp) are kept and marked. See `geometry::sweep::compensation`.
+pub fn compensate_scan(
+    points: &[RawPoint],
+    ball_radius_mm: f64,
+    plane_normal: Vector3<f64>,
+) -> Vec<Compensated> {
+    let path: Vec<(Point3<f64>, Vector3<f64>)> = points
+        .iter()
+        .map(|raw| (Point3::from(raw.centre), Vector3::from(raw.normal)))
+        .collect();
+    // A scan file is treated as an open path even when it goes round the section: the live pipeline cannot wrap
+    // round before the scan ends, and the report must hold the deviations that were published.
+    compensate_path(
+        CompensationSettings::new(ball_radius_mm),
+        plane_normal,
+        &path,
+        false,
+    )
+}
+
+/// The surface point a CMM's ball touched: the centre moved back one ball radius along the reported normal. What
+/// the station uses where it has a single point and no path: the way out of a cut scan
+/// (`station::job::cut_scan_path`); scans are compensated by [`compensate_scan`].
 ///
 /// The normal is normalised first: controllers report it to a few digits only, and a normal 0.1 % long would
 /// misplace the point by 0.1 % of the ball radius. A zero normal gives non-finite coordinates, which a gauge

@@ -72,11 +72,13 @@ impl Watch {
                 scan,
                 deviation_mm,
                 surface_mm,
+                flagged,
                 ..
             } => {
                 if let Some(instance) = self.instances.get_mut(&scan.instance) {
                     instance.points += 1;
-                    if let Some(d) = deviation_mm {
+                    // As the daemon's statistics: flagged points are shown as points, not in the figures.
+                    if let (Some(d), false) = (deviation_mm, flagged) {
                         instance.stats.push(*d, *surface_mm);
                     }
                     let running = instance

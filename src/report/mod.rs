@@ -113,6 +113,10 @@ pub struct PointRecord {
     pub off_plane_mm: f64,
     /// The I++ quality the machine reported with the point.
     pub quality: f64,
+    /// Compensation flagged the contact as not unique (a cusp: the surface more concave than the ball): the point
+    /// is kept but left out of the statistics and the verdict. Absent (false) in older reports.
+    #[serde(default)]
+    pub flagged: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -36,6 +36,7 @@ fn profile(
                 deviation_mm,
                 off_plane_mm: 0.002 * t,
                 quality: 1.0,
+                flagged: false,
             }
         })
         .collect();
@@ -146,7 +147,7 @@ fn deviations_csv_has_a_header_with_units_and_one_row_per_point() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "instance,profile,index,x_mm,y_mm,z_mm,deviation_mm,off_plane_mm,quality"
+        "instance,profile,index,x_mm,y_mm,z_mm,deviation_mm,off_plane_mm,quality,flagged"
     );
     let points: usize = report
         .instances
@@ -163,7 +164,7 @@ fn deviations_csv_has_a_header_with_units_and_one_row_per_point() {
         .expect("the row of blade-B p300 point 0");
     assert_eq!(
         *row,
-        "blade-B,p300,0,300.000000,40.000000,0.000000,0.110000,0.000000,1"
+        "blade-B,p300,0,300.000000,40.000000,0.000000,0.110000,0.000000,1,0"
     );
 }
 

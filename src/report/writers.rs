@@ -15,7 +15,7 @@ pub const SUMMARY_FILE: &str = "summary.txt";
 const CSV_DECIMALS: usize = 6;
 
 /// The columns of deviations.csv; lengths are in mm, as their names say.
-const CSV_HEADER: [&str; 9] = [
+const CSV_HEADER: [&str; 10] = [
     "instance",
     "profile",
     "index",
@@ -25,10 +25,12 @@ const CSV_HEADER: [&str; 9] = [
     "deviation_mm",
     "off_plane_mm",
     "quality",
+    "flagged",
 ];
 
 /// Writes report.json, deviations.csv (one row per point: instance, profile, index, x_mm, y_mm, z_mm of the surface
-/// point, deviation_mm, off_plane_mm, quality; header row names units) and summary.txt into `dir` (created if
+/// point, deviation_mm, off_plane_mm, quality, flagged (1 where compensation flagged the contact, a point left out
+/// of the statistics); header row names units) and summary.txt into `dir` (created if
 /// missing), each file atomically. Errors name the file.
 pub fn write_report(dir: &Path, report: &PartReport) -> std::io::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| {
@@ -69,6 +71,7 @@ fn deviations_csv(report: &PartReport) -> Vec<u8> {
                             mm(point.deviation_mm),
                             mm(point.off_plane_mm),
                             point.quality.to_string(),
+                            u8::from(point.flagged).to_string(),
                         ]
                     })
             })

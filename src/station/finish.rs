@@ -5,15 +5,13 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
-
 use super::job::job_scans;
 use super::journal::{file_stem, JobDir, JobRecord};
 use super::pipeline::scan_ref;
+use crate::analysis::compensate_scan;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
-use crate::analysis::surface_point;
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
@@ -45,15 +43,25 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
             .read_scan(&scan_ref(plan, key))
             .map_err(|e| e.to_string())?;
         let to_part = plan.instance_to_machine(key.instance).inverse();
-        let (points, normals) = scan
-            .points
+        let compensated = compensate_scan(
+            &scan.points,
+            scan.header.ball_radius_mm,
+            plan.plane_normal(key.instance),
+        );
+        // A flagged contact (a cusp) is not a point of the surface: the reference is fitted without it.
+        let flagged = compensated.iter().filter(|c| c.is_flagged()).count();
+        if flagged > 0 {
+            tracing::warn!(
+                scan = %plan.describe(key),
+                flagged,
+                points = compensated.len(),
+                "teach: points left out of the reference fit, their contact not unique (a cusp)"
+            );
+        }
+        let (points, normals) = compensated
             .iter()
-            .map(|raw| {
-                (
-                    to_part * surface_point(raw, scan.header.ball_radius_mm),
-                    to_part * Vector3::from(raw.normal).normalize(),
-                )
-            })
+            .filter(|c| !c.is_flagged())
+            .map(|c| (to_part * c.surface, to_part * c.normal))
             .unzip();
         profiles.push(MasterProfile {
             name: plan.profile_names()[key.profile].to_string(),
@@ -160,8 +168,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let mut stats = RunningStats::default();
             let mut profile_outside = 0;
             let mut points = Vec::with_capacity(scan.points.len());
-            for raw in &scan.points {
-                let surface = surface_point(raw, radius);
+            let compensated =
+                compensate_scan(&scan.points, radius, plan.plane_normal(key.instance));
+            let mut flagged = 0;
+            for (raw, point) in scan.points.iter().zip(&compensated) {
+                let surface = point.surface;
                 let measured = gauge.measure(&(to_part * surface)).map_err(|e| {
                     format!(
                         "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
@@ -172,9 +183,14 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                         surface.z
                     )
                 })?;
-                stats.push(measured.deviation_mm, surface.coords.into());
-                if !inputs.tolerance.contains(measured.deviation_mm) {
-                    profile_outside += 1;
+                // Flagged points are reported, marked, but left out of the statistics and the verdict.
+                if point.is_flagged() {
+                    flagged += 1;
+                } else {
+                    stats.push(measured.deviation_mm, surface.coords.into());
+                    if !inputs.tolerance.contains(measured.deviation_mm) {
+                        profile_outside += 1;
+                    }
                 }
                 points.push(PointRecord {
                     centre: raw.centre,
@@ -183,7 +199,16 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     deviation_mm: measured.deviation_mm,
                     off_plane_mm: measured.off_plane_mm,
                     quality: raw.quality,
+                    flagged: point.is_flagged(),
                 });
+            }
+            if flagged > 0 {
+                tracing::warn!(
+                    scan = %plan.describe(key),
+                    flagged,
+                    points = points.len(),
+                    "report: points left out of the statistics, their contact not unique (a cusp)"
+                );
             }
             let summary = stats
                 .summary()
@@ -234,7 +259,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             _ => "exact orthogonal distance to each profile's 2-D implicit polynomial, in the master's frame"
                 .into(),
         },
-        compensation: "ball centre moved back one ball radius along the reported surface normal".into(),
+        compensation: "ball centre moved back along the normal of the ball-centre path (local quartic fit over 9 \
+                       points), slid into the section plane by the reported normal's tilt; the reported normal at \
+                       a scan's first and last 4 points and where the path cannot be fitted; points where the \
+                       surface is more concave than the ball flagged and left out of the statistics"
+            .into(),
         tolerance: inputs.tolerance,
         instances,
         verdict: verdict.clone(),

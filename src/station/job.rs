@@ -307,6 +307,8 @@ impl Job {
         let (header, points) = self.dir.read_partial(&scan_ref(&self.plan, key)).ok()??;
         let (_, mut path) = self.scan_and_path(key);
         if self.reference.is_none() {
+            // Along the reported normals, point by point: the way out needs a safe path near the surface, not
+            // the compensated contacts, and a cut scan's last points have no look-ahead anyway.
             for raw in &points {
                 path.surface.push(surface_point(raw, header.ball_radius_mm));
                 path.normals.push(Vector3::from(raw.normal).normalize());

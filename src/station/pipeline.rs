@@ -1,13 +1,16 @@
-//! A job's analysis, off the machine workers: every point a worker forwards is compensated for the probe ball,
-//! measured against the reference (when inspecting), published at once, and handed to the job's recorder, which
-//! writes it to disk on its own thread; when a profile's scan ends the recorder writes its scan file, and only then
-//! does the profile count as done. The queue from the workers is bounded, so analysis that falls behind slows
-//! scanning down rather than losing points.
+//! A job's analysis, off the machine workers: every point a worker forwards is handed at once to the job's
+//! recorder, which writes it to disk on its own thread; it is compensated for the probe ball from the path of ball
+//! centres around it (`geometry::sweep::compensation`: a point is compensated once the four points after it have
+//! arrived, the last four when the scan ends), measured against the reference (when inspecting) and published.
+//! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done.
+//! Points whose contact compensation flags (a cusp: the surface more concave than the ball) are published and
+//! recorded but left out of the profile's statistics and verdict, and counted in the log. The queue from the
+//! workers is bounded, so analysis that falls behind slows scanning down rather than losing points.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use tokio::sync::{broadcast, mpsc};
 
 use super::clock;
@@ -16,8 +19,9 @@ use super::recorder::{Record, Recorder};
 use super::DaemonMsg;
 use crate::analysis::deviation::{ProfileGauge, ScanGauge};
 use crate::analysis::stats::{RunningStats, Tolerance};
-use crate::analysis::{surface_point, RawPoint};
+use crate::analysis::RawPoint;
 use crate::api::{Event, ScanRef};
+use crate::geometry::sweep::compensation::{Compensated, CompensationSettings, Compensator};
 use crate::plan::{Plan, ProfileKey};
 
 /// Points in flight between the workers and the analysis: about a minute of scanning at 20 points a second per
@@ -64,8 +68,13 @@ struct Active<'g> {
     points: Vec<RawPoint>,
     machine_to_part: Isometry3<f64>,
     gauge: Option<ScanGauge<'g>>,
+    compensator: Compensator,
+    /// When each point not yet compensated arrived, in scan order.
+    waiting: VecDeque<u64>,
     stats: RunningStats,
     outside: usize,
+    /// Points kept but left out of the statistics: compensation flagged their contact.
+    flagged: usize,
 }
 
 impl Pipeline {
@@ -101,6 +110,10 @@ impl Pipeline {
                         header: header.clone(),
                     });
                     let machine_to_part = self.plan.instance_to_machine(key.instance).inverse();
+                    let compensator = Compensator::new(
+                        CompensationSettings::new(ball_radius_mm),
+                        self.plan.plane_normal(key.instance),
+                    );
                     let mut gauge = gauges.as_deref().map(|g| g[key.profile].scan());
                     if let Some(gauge) = gauge.as_mut() {
                         // Without a neighbour's foot to start from, a point needs the gauge's full search.
@@ -113,8 +126,11 @@ impl Pipeline {
                             points: Vec::new(),
                             machine_to_part,
                             gauge,
+                            compensator,
+                            waiting: VecDeque::new(),
                             stats: RunningStats::default(),
                             outside: 0,
+                            flagged: 0,
                         },
                     );
                 }
@@ -126,12 +142,18 @@ impl Pipeline {
                     let Some(profile) = active.get_mut(&key) else {
                         continue;
                     };
-                    let event = self.measure(key, profile, raw, received_us);
-                    let _ = self.events.send(event);
+                    profile.points.push(raw);
+                    profile.waiting.push_back(received_us);
                     let _ = recorder.send(Record::Point { key, raw });
+                    let centre = Point3::from(raw.centre);
+                    if let Some(point) = profile.compensator.push(centre, Vector3::from(raw.normal))
+                    {
+                        self.publish(key, profile, point);
+                    }
                 }
                 PipelineMsg::End { key } => {
-                    if let Some(profile) = active.remove(&key) {
+                    if let Some(mut profile) = active.remove(&key) {
+                        self.publish_rest(key, &mut profile);
                         let stats = profile.stats.summary();
                         let _ = recorder.send(Record::End {
                             key,
@@ -142,24 +164,50 @@ impl Pipeline {
                     }
                 }
                 PipelineMsg::Cut { key } => {
-                    active.remove(&key);
+                    // The points measured before the cut are published too (from the reported normals at the
+                    // path's new end): they are in the partial file.
+                    if let Some(mut profile) = active.remove(&key) {
+                        self.publish_rest(key, &mut profile);
+                    }
                     let _ = recorder.send(Record::Cut { key });
                 }
             }
         }
     }
 
-    /// Compensates, measures and records one point; returns its event.
+    /// Publishes the points still waiting for their look-ahead when a scan ends, and logs the flagged ones.
+    fn publish_rest(&self, key: ProfileKey, profile: &mut Active<'_>) {
+        for point in profile.compensator.finish() {
+            self.publish(key, profile, point);
+        }
+        if profile.flagged > 0 {
+            tracing::warn!(
+                job = %self.job,
+                scan = %self.plan.describe(key),
+                flagged = profile.flagged,
+                points = profile.points.len(),
+                "points kept but left out of the statistics: their contact is not unique (the surface is more concave than the ball there, or the ball's path is tighter than the ball)"
+            );
+        }
+    }
+
+    /// Measures a compensated point and publishes its event.
+    fn publish(&self, key: ProfileKey, profile: &mut Active<'_>, point: Compensated) {
+        let received_us = profile.waiting.pop_front().unwrap_or_default();
+        let event = self.measure(key, profile, point, received_us);
+        let _ = self.events.send(event);
+    }
+
+    /// Measures one compensated point; returns its event.
     fn measure(
         &self,
         key: ProfileKey,
         profile: &mut Active<'_>,
-        raw: RawPoint,
+        point: Compensated,
         received_us: u64,
     ) -> Event {
-        let index = profile.points.len();
-        profile.points.push(raw);
-        let surface = surface_point(&raw, profile.header.ball_radius_mm);
+        let index = point.index;
+        let surface = point.surface;
         let deviation = profile.gauge.as_mut().and_then(|gauge| {
             let in_part = profile.machine_to_part * surface;
             match gauge.measure(&in_part) {
@@ -170,7 +218,9 @@ impl Pipeline {
                 }
             }
         });
-        if let Some(d) = deviation {
+        if point.is_flagged() {
+            profile.flagged += 1;
+        } else if let Some(d) = deviation {
             profile.stats.push(d, surface.coords.into());
             if !self.tolerance.contains(d) {
                 profile.outside += 1;
@@ -183,6 +233,7 @@ impl Pipeline {
             index,
             surface_mm: surface.coords.into(),
             deviation_mm: deviation,
+            flagged: point.is_flagged(),
             received_unix_us: received_us,
         }
     }
@@ -197,5 +248,219 @@ pub fn scan_ref(plan: &Plan, key: ProfileKey) -> ScanRef {
     ScanRef {
         instance: plan.instance_names()[key.instance].clone(),
         profile: plan.profile_names()[key.profile].to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use nalgebra::Isometry3;
+
+    use super::*;
+    use crate::analysis::stats::DeviationStats;
+    use crate::analysis::test_profiles::{taught_ellipses, Ellipse};
+    use crate::api::JobKind;
+    use crate::config::PartConfig;
+    use crate::station::journal::{JobRecord, JobState};
+
+    const BALL: f64 = 1.0;
+
+    /// A point event's fields the tests look at.
+    struct PointEvent {
+        index: usize,
+        surface: [f64; 3],
+        deviation: Option<f64>,
+        flagged: bool,
+        received: u64,
+    }
+
+    /// What the pipeline published for one scan.
+    struct Published {
+        /// In the order published.
+        points: Vec<PointEvent>,
+        stats: Option<DeviationStats>,
+    }
+
+    /// Runs a pipeline on the propeller's plan (master at the machine's origin) over one scan of instance A's
+    /// profile `profile`: `Start`, the raw points (each received at 1000 + its index us), then `last`.
+    async fn run(
+        profile: usize,
+        gauges: Option<Arc<Vec<ProfileGauge>>>,
+        raws: &[RawPoint],
+        last: fn(ProfileKey) -> PipelineMsg,
+    ) -> Published {
+        let part = PartConfig::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("config/parts/propeller.toml"),
+        )
+        .unwrap();
+        let plan = Arc::new(Plan::new(&part, Isometry3::identity()));
+        let data = tempfile::tempdir().unwrap();
+        let record = JobRecord {
+            id: "sweep-test".into(),
+            kind: JobKind::Inspect,
+            part: "propeller".into(),
+            serial: None,
+            started: "2026-11-23T10:00:00Z".into(),
+            state: JobState::Open,
+            report: None,
+        };
+        let dir = JobDir::create(data.path(), &record).unwrap();
+        let (events, mut watch) = broadcast::channel(4 * QUEUE_POINTS);
+        let (daemon, _daemon_inbox) = mpsc::channel(16);
+        let pipeline = Pipeline {
+            job: record.id.clone(),
+            plan,
+            dir,
+            gauges,
+            tolerance: Tolerance {
+                lower_mm: -0.1,
+                upper_mm: 0.1,
+            },
+            events,
+            daemon,
+        };
+        let (to_pipeline, inbox) = mpsc::channel(QUEUE_POINTS);
+        tokio::spawn(pipeline.run(inbox));
+        let key = ProfileKey {
+            instance: 0,
+            profile,
+        };
+        let start = PipelineMsg::Start {
+            key,
+            machine: "cmm1".into(),
+            ball_radius_mm: BALL,
+            entry: Point3::from(raws[0].centre),
+        };
+        to_pipeline.send(start).await.unwrap();
+        for (i, raw) in raws.iter().enumerate() {
+            let point = PipelineMsg::Point {
+                key,
+                raw: *raw,
+                received_us: 1000 + i as u64,
+            };
+            to_pipeline.send(point).await.unwrap();
+        }
+        to_pipeline.send(last(key)).await.unwrap();
+        let mut published = Published {
+            points: Vec::new(),
+            stats: None,
+        };
+        let ends_with_done = matches!(last(key), PipelineMsg::End { .. });
+        while published.points.len() < raws.len() || ends_with_done {
+            match watch.recv().await.unwrap() {
+                Event::Point {
+                    index,
+                    surface_mm,
+                    deviation_mm,
+                    flagged,
+                    received_unix_us,
+                    ..
+                } => published.points.push(PointEvent {
+                    index,
+                    surface: surface_mm,
+                    deviation: deviation_mm,
+                    flagged,
+                    received: received_unix_us,
+                }),
+                Event::ProfileDone { stats, .. } => {
+                    published.stats = stats;
+                    break;
+                }
+                _ => {}
+            }
+        }
+        published
+    }
+
+    /// The ball's centres round the section x = 300 of the taught elliptic blade (in-plane normals, 0.36 mm
+    /// apart), with a V-shaped dent 0.5 mm deep in the path on the top: a concave corner the ball cannot follow at
+    /// its bottom.
+    fn dented_ellipse_scan() -> Vec<RawPoint> {
+        let section = Ellipse { x: 300.0 };
+        let count = 600;
+        let dent_at = count / 4;
+        (0..count)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / count as f64;
+                let n = section.normal_in_plane(t);
+                let normal = Vector3::new(0.0, n.x, n.y);
+                let from_dent = (i as f64 - dent_at as f64).abs();
+                let dent = 0.5 * (1.0 - from_dent / 3.0).max(0.0);
+                RawPoint {
+                    centre: (section.point(t) + normal * (BALL - dent)).coords.into(),
+                    normal: normal.into(),
+                    quality: 1.0,
+                }
+            })
+            .collect()
+    }
+
+    #[tokio::test]
+    async fn sweep_compensated_points_are_published_once_in_order_and_flagged_ones_left_out_of_the_stats(
+    ) {
+        let reference = taught_ellipses();
+        let gauges: Vec<ProfileGauge> = ProfileGauge::all(reference);
+        let raws = dented_ellipse_scan();
+        let published = run(2, Some(Arc::new(gauges)), &raws, |key| PipelineMsg::End {
+            key,
+        })
+        .await;
+        let indices: Vec<usize> = published.points.iter().map(|p| p.index).collect();
+        assert_eq!(indices, (0..raws.len()).collect::<Vec<_>>());
+        // Each event carries its own point's arrival, not that of the point that completed its look-ahead.
+        assert!(published
+            .points
+            .iter()
+            .all(|p| p.received == 1000 + p.index as u64));
+        let flagged: Vec<usize> = published
+            .points
+            .iter()
+            .filter(|p| p.flagged)
+            .map(|p| p.index)
+            .collect();
+        assert!(!flagged.is_empty());
+        assert!(
+            flagged
+                .iter()
+                .all(|i| i.abs_diff(150) <= 3 + crate::geometry::sweep::compensation::LOOK_AHEAD),
+            "{flagged:?}"
+        );
+        // The dent's bottom is flagged, and still published with its deviation.
+        assert!(flagged.contains(&150));
+        assert!(published.points[150].deviation.is_some());
+        let stats = published.stats.expect("inspect statistics");
+        let counted = published
+            .points
+            .iter()
+            .filter(|p| !p.flagged && p.deviation.is_some())
+            .count();
+        assert_eq!(stats.points, counted);
+        assert_eq!(stats.points + flagged.len(), raws.len());
+        // Away from the dent the compensated points lie on the taught section: the fit's own error, some um.
+        let off_dent = published
+            .points
+            .iter()
+            .filter(|p| {
+                p.index.abs_diff(150) > 3 + crate::geometry::sweep::compensation::LOOK_AHEAD
+            })
+            .map(|p| p.deviation.unwrap().abs())
+            .fold(0.0, f64::max);
+        assert!(off_dent < 0.01, "{off_dent}");
+    }
+
+    #[tokio::test]
+    async fn sweep_points_waiting_for_their_look_ahead_are_published_when_a_scan_is_cut() {
+        let raws = dented_ellipse_scan();
+        let published = run(2, None, &raws[..6], |key| PipelineMsg::Cut { key }).await;
+        let indices: Vec<usize> = published.points.iter().map(|p| p.index).collect();
+        assert_eq!(indices, (0..6).collect::<Vec<_>>());
+        // Teaching: no deviations; the surface is the centre one ball radius in along the normal.
+        for point in &published.points {
+            assert!(point.deviation.is_none() && !point.flagged);
+            let raw = raws[point.index];
+            let expected = Point3::from(raw.centre) - Vector3::from(raw.normal) * BALL;
+            assert!((Point3::from(point.surface) - expected).norm() < 1e-12);
+        }
     }
 }

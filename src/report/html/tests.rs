@@ -44,6 +44,7 @@ fn section(radius: f64, azimuth_deg: f64, lift_mm: f64) -> Vec<PointRecord> {
                 deviation_mm: lift_mm * normal[2],
                 off_plane_mm: 0.0,
                 quality: 1.0,
+                flagged: false,
             }
         })
         .collect()

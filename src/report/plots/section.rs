@@ -148,6 +148,7 @@ mod tests {
                     deviation_mm: k as f64,
                     off_plane_mm: 0.0,
                     quality: 1.0,
+                    flagged: false,
                 }
             })
             .collect()

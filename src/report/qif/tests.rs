@@ -41,6 +41,7 @@ fn profile(name: &str, x_mm: f64, machine: &str, deviations: [f64; 6]) -> Profil
                 deviation_mm,
                 off_plane_mm: 0.0003 * t,
                 quality: 0.5 + 0.1 * t,
+                flagged: false,
             }
         })
         .collect();
