@@ -217,19 +217,13 @@ mod tests {
         for v in &mesh.vertices {
             assert!(solid.value(v).abs() < params.epsilon, "{v}");
         }
-        // Stratified Monte Carlo with 80^3 points: its own spread is about 0.1 %; the mesh's
-        // chords cut the curved surfaces by about 0.3 % at this cell. Leaving out the bore (18 %)
-        // or the lobe (6 %) fails by far.
+        // Stratified Monte Carlo with 80^3 points (about 33 250 mm^3, its spread well below
+        // 0.1 %); the mesh came within 0.04 % of it. Tolerance 0.5 %: keeping the bore's material
+        // (about 2 700 mm^3, 8 %) or dropping the lobes fails by far.
         let reference = monte_carlo_volume(&solid, 80);
         let error = (mesh.volume() - reference) / reference;
-        eprintln!(
-            "TEMP nut: volume {} reference {reference} error {error} vertices {} triangles {}",
-            mesh.volume(),
-            mesh.vertices.len(),
-            mesh.triangles.len()
-        );
         assert!(
-            error.abs() < 0.01,
+            error.abs() < 0.005,
             "{} vs {reference}: {error}",
             mesh.volume()
         );
@@ -243,7 +237,6 @@ mod tests {
             .filter(|v| hexagon.value(v).abs() < 1e-6 && bore.value(v).abs() < 1e-6)
             .count();
         let rims = 2.0 * std::f64::consts::TAU * BORE;
-        eprintln!("TEMP rims {on_rims} bound {}", rims / params.delta);
         assert!(
             on_rims as f64 >= rims / params.delta,
             "{on_rims} vertices on the rims"
@@ -270,7 +263,6 @@ mod tests {
                 (exact - mesh.volume()) / exact
             })
             .collect();
-        eprintln!("TEMP ellipsoid errors {errors:?}");
         // Vertices on the surface, flat triangles inside it: the error is positive and falls
         // with the square of the cell.
         assert!(errors.iter().all(|&e| e > 0.0), "{errors:?}");
