@@ -42,7 +42,7 @@ impl Grid {
         let mut ijk = [0; 3];
         for axis in 0..3 {
             let t = ((p[axis] - self.origin[axis]) / self.cell).floor();
-            if !(t >= 0.0 && t < (self.dims[axis] - 1) as f64) {
+            if t.is_nan() || t < 0.0 || t >= (self.dims[axis] - 1) as f64 {
                 return None;
             }
             ijk[axis] = t as u64;

@@ -185,7 +185,7 @@ pub(super) fn curve_point(
         let (a, b, c) = (gi.dot(&gi), gi.dot(&gj), gj.dot(&gj));
         let det = a * c - b * b;
         // sin^2 of the angle between the normals below 1e-6: too tangent to meet in a sharp edge.
-        if !(det > 1e-6 * a * c) {
+        if det.is_nan() || det <= 1e-6 * a * c {
             return None;
         }
         let (li, lj) = ((c * fi - b * fj) / det, (a * fj - b * fi) / det);

@@ -278,12 +278,10 @@ mod tests {
             .collect();
         assert_eq!(read.vertices.len(), distinct.len());
         for (face, t) in read.faces.iter().zip(&mesh.triangles) {
-            for k in 0..3 {
-                let expected = mesh.vertices[t[k] as usize];
-                let got = read.vertices[face.vertices[k]].0;
-                for axis in 0..3 {
-                    assert_eq!(got[axis], expected[axis] as f32);
-                }
+            for (&read_index, &index) in face.vertices.iter().zip(t) {
+                let expected = mesh.vertices[index as usize];
+                let got = read.vertices[read_index].0;
+                assert_eq!(got, [expected.x, expected.y, expected.z].map(|c| c as f32));
             }
         }
     }
