@@ -5,7 +5,9 @@ mod control;
 pub mod demo;
 mod deviate;
 mod fit;
+mod mesh;
 mod station;
+mod sweep;
 mod watch;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -51,6 +53,10 @@ enum Command {
     Fit(FitCommand),
     /// Signed deviations (mm, positive outside the material) of measured points from a reference model.
     Deviate(deviate::DeviateArgs),
+    /// Polygonise a supershape model into a closed mesh (STL, PLY or OBJ by the file's extension).
+    Mesh(mesh::MeshArgs),
+    /// The clearance of every move of a taught part's inspection (mm) and the silhouette of the swept ball (SVG).
+    Sweep(sweep::SweepArgs),
     /// Run the simulated CMMs of a simulator configuration (the same as the zeroset-sim binary).
     ///
     /// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT, SIGTERM or the end of
@@ -112,6 +118,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
         Command::Deviate(args) => deviate::run(&args),
+        Command::Mesh(args) => mesh::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
         Command::Sim(args) => zeroset_sim::cli::run(&args),
         Command::Demo(args) => demo::run(&args),
         Command::Daemon(station) => station::daemon(&station),

@@ -13,8 +13,10 @@
 use nalgebra::Point3;
 
 use super::escape::{way_out, KnownPath};
+use super::job::{job_scans, load_plan, reference_path, scan_margin_mm};
 use crate::analysis::part_mesh::part_mesh;
 use crate::analysis::Reference;
+use crate::api::JobKind;
 use crate::config::StationConfig;
 use crate::geometry::sweep::clearance::{check_move, Clearance};
 use crate::geometry::sweep::mesh::MeshPart;
@@ -169,6 +171,41 @@ pub fn check_moves(
             CheckedMove { planned, clearance }
         })
         .collect()
+}
+
+/// The part's taught model on the machine and every move of its inspection with its clearance, contact scans
+/// included, for `zeroset sweep`.
+pub struct PlanSweep {
+    pub plan: Plan,
+    pub stylus: Stylus,
+    pub part: MeshPart,
+    pub moves: Vec<CheckedMove>,
+}
+
+/// Loads the part and its reference as the daemon would for an inspection, and checks every move.
+pub fn sweep_plan(config: &StationConfig, part: &str) -> Result<PlanSweep, String> {
+    let plan = load_plan(config, part).map_err(|e| e.to_string())?;
+    let path = reference_path(config, part);
+    let reference = Reference::load(&path).map_err(|e| {
+        format!("{e}; teach the part first (`zeroset teach {part}`): the moves are checked against its reference")
+    })?;
+    let stylus = station_stylus(config)?;
+    let mesh = machine_part(&plan, &reference)?;
+    let moves = inspection_moves(
+        &plan,
+        &reference,
+        &job_scans(&plan, JobKind::Inspect),
+        stylus.ball_radius_mm,
+        scan_margin_mm(&plan, JobKind::Inspect),
+        config.safety.clearance_z_mm,
+    )?;
+    let moves = check_moves(&stylus, moves, &mesh, config.safety.move_margin_mm);
+    Ok(PlanSweep {
+        plan,
+        stylus,
+        part: mesh,
+        moves,
+    })
 }
 
 /// The first free move (descent, lift-off or way out) closer than `margin_mm`, as the operator's message.

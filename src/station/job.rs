@@ -329,7 +329,7 @@ impl Job {
 
 /// The scans a job of this kind makes.
 /// How far the probe keeps off the known surface when entering and leaving a scan of a job of `kind`, mm.
-fn scan_margin_mm(plan: &Plan, kind: JobKind) -> f64 {
+pub(super) fn scan_margin_mm(plan: &Plan, kind: JobKind) -> f64 {
     match kind {
         JobKind::Teach => TEACH_MARGIN_MM,
         JobKind::Inspect => plan.scan_settings().max_deviation_mm + INSPECT_EXTRA_MARGIN_MM,

@@ -10,3 +10,4 @@ mod readme;
 mod sim;
 mod station;
 mod support;
+mod sweep;
