@@ -115,7 +115,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
 fn names<'p>(plan: &'p crate::plan::Plan, checked: &CheckedMove) -> (&'p str, &'p str) {
     (
         &plan.instance_names()[checked.planned.key.instance],
-        &plan.profile_names()[checked.planned.key.profile],
+        plan.profile_names()[checked.planned.key.profile],
     )
 }
 
