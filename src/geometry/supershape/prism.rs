@@ -15,22 +15,21 @@
 //! one period, a few exponent sets) and the smallest cost wins, since the radial cost has local minima
 //! at turns of half a lobe.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{
-    DMatrix as DMatrixF, DVector as DVectorF, Isometry3, Matrix3, Point2, Rotation3, Translation3,
-    UnitQuaternion,
-};
+use nalgebra::{Isometry3, Matrix3, Point2, Rotation3, Translation3, UnitQuaternion};
 use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
 
 use super::deform::{Deformation, Deformations};
 use super::formula::{Superformula, SuperformulaError};
+use super::jacobian::central_differences;
+use super::lobes;
 use super::shape::Supershape;
 
 /// The exponents of the square r2 that makes a supershape a prism: the side wall is rho = r1 to within
 /// r1 tan(phi)^n / n, below 1e-20 of the size over the middle 80% of the height.
-const SQUARE_EXPONENT: f64 = 200.0;
+pub(super) const SQUARE_EXPONENT: f64 = 200.0;
 /// Symmetry numbers tried when none is given.
 const SYMMETRIES: std::ops::RangeInclusive<usize> = 2..=12;
 /// Fewer points than this cannot fix seven parameters against a machine's noise.
@@ -107,7 +106,7 @@ pub fn fit_prism_section(
     if points.len() < MIN_POINTS {
         return Err(PrismFitError::TooFewPoints { got: points.len() });
     }
-    let centroid = circle_centre(points);
+    let centroid = lobes::circle_centre(points);
     let m = match symmetry {
         Some(m) => m,
         None => dominant_harmonic(points, &centroid).ok_or(PrismFitError::NoSymmetry)?,
@@ -160,53 +159,11 @@ pub fn fit_prism_section(
     Ok(section)
 }
 
-/// The centre of the circle closest to the points (Kasa's algebraic fit: x^2 + y^2 + D x + E y + F = 0
-/// in least squares). For an outline with two or more lobes it is the outline's centre however the scan
-/// is spread along it, where the points' centroid would lean towards where they are dense.
-fn circle_centre(points: &[Point2<f64>]) -> Point2<f64> {
-    let rows = DMatrixF::from_fn(points.len(), 3, |i, j| match j {
-        0 => points[i].x,
-        1 => points[i].y,
-        _ => 1.0,
-    });
-    let rhs = DVectorF::from_fn(points.len(), |i, _| -points[i].coords.norm_squared());
-    let solution = rows
-        .svd(true, true)
-        .solve(&rhs, 1e-12)
-        .expect("an SVD with both factors solves");
-    Point2::new(-solution[0] / 2.0, -solution[1] / 2.0)
-}
-
-/// The number of lobes: the harmonic k (2..=12) with the largest amplitude of the radius about the
-/// centroid, the radii first averaged in 720 angular bins so that where the scan is dense does not weigh.
+/// The number of lobes of the outline: the strongest harmonic, if it stands out of a round outline's noise.
 fn dominant_harmonic(points: &[Point2<f64>], centroid: &Point2<f64>) -> Option<usize> {
-    const BINS: usize = 720;
-    let mut sums = vec![(0.0, 0usize); BINS];
-    for p in points {
-        let d = p - centroid;
-        let bin = (((d.y.atan2(d.x) + PI) / TAU * BINS as f64) as usize).min(BINS - 1);
-        sums[bin].0 += d.norm();
-        sums[bin].1 += 1;
-    }
-    let filled: Vec<(f64, f64)> = sums
-        .iter()
-        .enumerate()
-        .filter(|(_, (_, n))| *n > 0)
-        .map(|(i, (sum, n))| ((i as f64 + 0.5) / BINS as f64 * TAU - PI, sum / *n as f64))
-        .collect();
-    let mean = filled.iter().map(|(_, r)| r).sum::<f64>() / filled.len() as f64;
-    let amplitude = |k: usize| {
-        let (c, s) = filled.iter().fold((0.0, 0.0), |(c, s), (theta, r)| {
-            let (sin, cos) = (k as f64 * theta).sin_cos();
-            (c + (r - mean) * cos, s + (r - mean) * sin)
-        });
-        c.hypot(s) / filled.len() as f64
-    };
-    let (k, best) = SYMMETRIES
-        .map(|k| (k, amplitude(k)))
-        .fold((0, 0.0), |b, n| if n.1 > b.1 { n } else { b });
+    let lobes = lobes::strongest(points, centroid, SYMMETRIES)?;
     // A lobed outline's first harmonic stands well above the noise of a round one.
-    (best > 1e-4 * mean).then_some(k)
+    (lobes.strength > 2e-4).then_some(lobes.count)
 }
 
 /// The radial least-squares problem of the section fit, parameters
@@ -260,18 +217,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialProblem<'_> {
     /// Central differences: seven parameters, and the exponents' partials of eq. 4 in closed form would
     /// add a page of code for no measurable gain in a fit made once per teach.
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let mut jacobian = DMatrix::zeros(self.points.len(), 7);
-        for j in 0..7 {
-            let h = 1e-7 * (1.0 + self.params[j].abs());
-            let (mut plus, mut minus) = (self.params, self.params);
-            plus[j] += h;
-            minus[j] -= h;
-            let (up, down) = (self.residuals_at(&plus)?, self.residuals_at(&minus)?);
-            for i in 0..self.points.len() {
-                jacobian[(i, j)] = (up[i] - down[i]) / (2.0 * h);
-            }
-        }
-        Some(jacobian)
+        central_differences(&self.params, |p| self.residuals_at(p))
     }
 }
 
@@ -299,7 +245,7 @@ mod tests {
         let noise = Normal::new(0.0, noise_mm.max(1e-300)).unwrap();
         (0..count)
             .map(|_| {
-                let theta: f64 = rng.gen_range(-PI..PI);
+                let theta: f64 = rng.gen_range(-std::f64::consts::PI..std::f64::consts::PI);
                 let r = truth.radius(theta)
                     + if noise_mm > 0.0 {
                         noise.sample(&mut rng)

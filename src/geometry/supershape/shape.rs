@@ -48,6 +48,21 @@ impl Supershape {
         )
     }
 
+    /// `count` surface points of eq. 5 spread over the parameters: latitudes evenly in sin(phi) (so that bands
+    /// of the unit sphere get points by their area), longitudes turned by the golden angle from one to the next.
+    /// For tests, benches and examples that need a scan of a known shape.
+    pub fn surface_points(&self, count: usize) -> Vec<Point3<f64>> {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..count)
+            .map(|k| {
+                let sin_phi = -1.0 + (2 * k + 1) as f64 / count as f64;
+                let theta =
+                    (golden * k as f64).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+                self.point(theta, sin_phi.asin())
+            })
+            .collect()
+    }
+
     /// The implicit function of seed 000 eq. 6 (seed 001 eq. 2),
     /// F1 = 1 - (x^2 + y^2 + r1^2 z^2) / (r1^2 r2^2), evaluated on the unscaled point. For P = t I with
     /// I on the surface it equals 1 - t^2.

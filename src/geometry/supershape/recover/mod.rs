@@ -1,0 +1,345 @@
+//! Supershape recovery from measured points (seed 001 sections 3-6): one supershape fitted by Levenberg-Marquardt
+//! to the radial cost a1 a2 a3 sum F2^2 (eq. 4), exponents and sizes through their logarithms, symmetry numbers
+//! read from sections along the inertia axes, the rational supershape (eqs. 8-9) for the first iterations, several
+//! starts; then holes found from points well inside the envelope and fitted as negative primitives, the envelope
+//! truncated by the oriented bounding box of its points, all combined by R_p (p = 2) into one solid; and the global
+//! error of fit (eq. 15) as the similarity of points to a model, with a pose fit against a fixed reference.
+//!
+//! The fit runs on points centred on their centroid and scaled to unit RMS radius, so that every parameter is of
+//! order one whatever the part's size; the model is returned in the points' own frame and units (mm).
+
+mod holes;
+mod model;
+mod problem;
+mod similarity;
+mod starts;
+mod symmetry;
+
+#[cfg(test)]
+mod tests;
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+use self::model::{Candidate, Radius};
+use self::problem::minimise;
+use super::csg::{Node, Solid};
+use super::deform::{Deformation, Deformations};
+use super::rfunc::{Boolean, RFunction};
+use super::shape::Supershape;
+
+pub use self::similarity::{
+    fit_pose, global_error, surface_distance_bound, surface_gap_rms, Pose, PoseFit,
+};
+
+/// Fewer points than this cannot fix fifteen parameters against noise.
+const MIN_POINTS: usize = 60;
+/// The rational first iterations run on at most this many of the points (evenly taken): a start only has to reach
+/// the right basin there, and every start costs the same whatever the scan's size.
+const EARLY_POINTS: usize = 400;
+/// The evaluation budgets of the two stages, in the crate's units (x 16 evaluations).
+const RATIONAL_PATIENCE: usize = 4;
+const STANDARD_PATIENCE: usize = 100;
+/// The best starts after the rational stage that the standard stage refines.
+const REFINED_STARTS: usize = 4;
+/// The truncating box lies this many RMS radial distances outside the points (at least this fraction of the
+/// points' RMS radius), so that it cuts away only what lies beyond the data, never the data's own surface.
+const BOX_MARGIN_RMS: f64 = 4.0;
+const BOX_MARGIN_MIN: f64 = 0.005;
+
+/// What the recovery may assume and do.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecoveryOptions {
+    /// The symmetry numbers m1, m2 when known (a superquadric is 4, 4); read from the points otherwise.
+    pub symmetry: Option<[u32; 2]>,
+    /// Cut the envelope by the oriented bounding box of its points (seed 001 eq. 14).
+    pub truncate: bool,
+    /// Look for holes (points well inside the envelope) and fit them as negative primitives (section 6.2).
+    pub holes: bool,
+}
+
+impl Default for RecoveryOptions {
+    fn default() -> Self {
+        Self {
+            symmetry: None,
+            truncate: true,
+            holes: true,
+        }
+    }
+}
+
+/// Why no supershape was recovered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RecoveryError {
+    #[error("{got} points cannot fix a supershape; give at least {MIN_POINTS} points spread over the part's surface")]
+    TooFewPoints { got: usize },
+    #[error("a point has a coordinate that is not a finite number (point {index})")]
+    NotFinite { index: usize },
+    #[error("no start converged ({starts} tried); check that the points are of one part, in mm")]
+    NoConvergence { starts: usize },
+}
+
+/// A recovered solid and how it was found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recovered {
+    /// The model, in the points' frame, mm: the envelope (truncated if asked) minus its holes.
+    pub solid: Solid,
+    /// The envelope supershape and its placement, before truncation and holes.
+    pub envelope: (Supershape, Deformations),
+    /// The negative primitives, each with its placement and whether it passes through the envelope.
+    pub holes: Vec<RecoveredHole>,
+    /// The envelope's symmetry numbers m1, m2.
+    pub symmetry: [u32; 2],
+    /// Whether both were read from the points (false when given or when one fell back to 4).
+    pub symmetry_detected: bool,
+    /// The starts tried for the envelope.
+    pub starts: usize,
+    /// Seed 001 eq. 15 at the points, mm^3.
+    pub global_error: f64,
+    /// The RMS of the envelope's radial distances |P| |F2| / (1 - F2) at its points, mm: an upper bound of
+    /// their Euclidean distances (the radial foot is a point of the surface).
+    pub rms_radial_mm: f64,
+}
+
+/// A hole of the recovered solid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecoveredHole {
+    pub shape: Supershape,
+    pub place: Deformations,
+    /// The points it was fitted to.
+    pub points: usize,
+    /// Whether its points run through the envelope, so that it was made a prism longer than the part.
+    pub through: bool,
+}
+
+/// The points' centroid and RMS radius, to fit in a frame where both are 0 and 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Normalisation {
+    centre: Vector3<f64>,
+    scale: f64,
+}
+
+impl Normalisation {
+    fn of(points: &[Point3<f64>]) -> Self {
+        let count = points.len() as f64;
+        let centre = points.iter().map(|p| p.coords).sum::<Vector3<f64>>() / count;
+        let scale = (points
+            .iter()
+            .map(|p| (p.coords - centre).norm_squared())
+            .sum::<f64>()
+            / count)
+            .sqrt();
+        Self { centre, scale }
+    }
+
+    fn apply(&self, p: &Point3<f64>) -> Point3<f64> {
+        Point3::from((p.coords - self.centre) / self.scale)
+    }
+
+    /// A supershape fitted in the normalised frame, placed in the points' frame.
+    fn placed(&self, candidate: &Candidate) -> (Supershape, Deformations) {
+        let (mut shape, _) = candidate.supershape();
+        shape.scale = shape.scale.map(|a| a * self.scale);
+        let p = &candidate.params;
+        let place = Isometry3::from_parts(
+            Translation3::from(self.centre + Vector3::new(p[0], p[1], p[2]) * self.scale),
+            UnitQuaternion::from_rotation_matrix(&candidate.rotation()),
+        );
+        (shape, Deformations(vec![Deformation::Rigid(place)]))
+    }
+}
+
+/// One supershape fitted to points of the normalised frame, with the number of starts tried and whether both
+/// symmetry numbers were read from the points.
+struct Fitted {
+    candidate: Candidate,
+    starts: usize,
+    detected: bool,
+}
+
+/// Recovers a solid from points on a part's surface (mm).
+pub fn recover(
+    points: &[Point3<f64>],
+    options: &RecoveryOptions,
+) -> Result<Recovered, RecoveryError> {
+    if points.len() < MIN_POINTS {
+        return Err(RecoveryError::TooFewPoints { got: points.len() });
+    }
+    if let Some(index) = points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(RecoveryError::NotFinite { index });
+    }
+    let normalisation = Normalisation::of(points);
+    let unit: Vec<Point3<f64>> = points.iter().map(|p| normalisation.apply(p)).collect();
+    let (envelope, outer, hole_fits) = if options.holes {
+        holes::separate(&unit, options.symmetry)?
+    } else {
+        let outer: Vec<usize> = (0..unit.len()).collect();
+        (fit_one(&unit, options.symmetry)?, outer, Vec::new())
+    };
+    let outer_points: Vec<Point3<f64>> = outer.iter().map(|&i| unit[i]).collect();
+    let rms_radial = rms_radial(&envelope.candidate, &outer_points);
+    let (shape, place) = normalisation.placed(&envelope.candidate);
+    let mut root = Node::supershape(shape, place.clone());
+    if options.truncate {
+        let margin = (BOX_MARGIN_RMS * rms_radial).max(BOX_MARGIN_MIN);
+        root = Node::boolean(
+            Boolean::Intersection,
+            RFunction::P(2),
+            root,
+            bounding_box(&envelope.candidate, &outer_points, margin, &normalisation),
+        );
+    }
+    let mut holes = Vec::new();
+    for hole in hole_fits {
+        let (shape, place) = normalisation.placed(&hole.fitted.candidate);
+        let (shape, place) = if hole.through {
+            holes::through_prism(shape, place, hole.length * normalisation.scale)
+        } else {
+            (shape, place)
+        };
+        root = Node::boolean(
+            Boolean::Difference,
+            RFunction::P(2),
+            root,
+            Node::supershape(shape, place.clone()),
+        );
+        holes.push(RecoveredHole {
+            shape,
+            place,
+            points: hole.points,
+            through: hole.through,
+        });
+    }
+    let solid = Solid::new(root);
+    Ok(Recovered {
+        global_error: global_error(&solid, points),
+        envelope: (shape, place),
+        holes,
+        symmetry: envelope.candidate.frame.symmetry,
+        symmetry_detected: envelope.detected,
+        starts: envelope.starts,
+        rms_radial_mm: rms_radial * normalisation.scale,
+        solid,
+    })
+}
+
+/// One supershape fitted to normalised points: every inertia axis's guess from two turns, the rational radius on
+/// a subsample first, then the best starts refined with the superformula on every point.
+///
+/// Starts are compared by their RMS radial distance to the points, not by the cost they minimise: eq. 4's
+/// volume term a1 a2 a3 has a degenerate minimum, a supershape shrunk to a point far from the data (there F2
+/// grows like 1 / a while the weight falls like a^3), which a start in the wrong basin can slide into.
+fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, RecoveryError> {
+    let early: Vec<Point3<f64>> = if points.len() > EARLY_POINTS {
+        (0..EARLY_POINTS)
+            .map(|k| points[k * points.len() / EARLY_POINTS])
+            .collect()
+    } else {
+        points.to_vec()
+    };
+    let starts: Vec<(Candidate, bool)> = symmetry::guesses(points, given)
+        .iter()
+        .flat_map(|guess| starts::of(points, guess, given))
+        .collect();
+    let tried_starts = starts.len();
+    let mut tried: Vec<(f64, Candidate, bool)> = starts
+        .into_iter()
+        .filter_map(|(candidate, detected)| {
+            // Seed 001 section 4: the rational form stands for the superformula only for exponents in [1, 4];
+            // a start outside (read from the points) goes straight to the superformula.
+            let radius = if candidate
+                .exponents()
+                .iter()
+                .all(|n| (1.0..=4.0).contains(n))
+            {
+                Radius::Rational
+            } else {
+                Radius::Standard
+            };
+            let (reached, _) = minimise(&early, candidate, radius, RATIONAL_PATIENCE)?;
+            let distance = rms_radial(&reached, &early);
+            distance
+                .is_finite()
+                .then_some((distance, reached, detected))
+        })
+        .collect();
+    let starts = tried_starts;
+    tried.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (_, best, detected) = tried
+        .into_iter()
+        .take(REFINED_STARTS)
+        .filter_map(|(_, candidate, detected)| {
+            let (reached, _) = minimise(&early, candidate, Radius::Standard, STANDARD_PATIENCE)?;
+            Some((rms_distance(&reached, &early), reached, detected))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .ok_or(RecoveryError::NoConvergence { starts })?;
+    let (candidate, _) = minimise(points, best, Radius::Standard, STANDARD_PATIENCE)
+        .ok_or(RecoveryError::NoConvergence { starts })?;
+    Ok(Fitted {
+        candidate,
+        starts,
+        detected,
+    })
+}
+
+/// The radial distance |P - I| = |P| |F2| / (1 - F2) of a point to a placed supershape, I the surface point on
+/// the ray from the supershape's centre through P: an upper bound of the Euclidean distance (I is on the
+/// surface) that costs one evaluation of eq. 3, for comparing starts and judging recoveries.
+pub fn radial_distance(shape: &Supershape, place: &Deformations, p: &Point3<f64>) -> f64 {
+    let q = place.inverse(p);
+    let f = shape.radial(&q);
+    q.coords.norm() * f.abs() / (1.0 - f)
+}
+
+/// The RMS of the distances of normalised points to a candidate's surface (`surface_distance_bound`): slower than
+/// the radial distance and tighter, for the final choice among refined starts, whose radial distances a shape
+/// seen edge-on along its rays inflates.
+fn rms_distance(candidate: &Candidate, points: &[Point3<f64>]) -> f64 {
+    let (shape, place) = candidate.supershape();
+    let sum: f64 = points
+        .iter()
+        .map(|p| similarity::surface_distance_bound(&shape, &place, p).powi(2))
+        .sum();
+    (sum / points.len() as f64).sqrt()
+}
+
+/// The RMS of the radial distances of normalised points to a candidate.
+fn rms_radial(candidate: &Candidate, points: &[Point3<f64>]) -> f64 {
+    let (shape, place) = candidate.supershape();
+    let sum: f64 = points
+        .iter()
+        .map(|p| radial_distance(&shape, &place, p).powi(2))
+        .sum();
+    (sum / points.len() as f64).sqrt()
+}
+
+/// The box of seed 001 eq. 14: the points' extent in the envelope's frame, `margin` larger on every side, in the
+/// points' frame (mm).
+fn bounding_box(
+    envelope: &Candidate,
+    points: &[Point3<f64>],
+    margin: f64,
+    normalisation: &Normalisation,
+) -> Node {
+    let rotation = envelope.rotation();
+    let (low, high) = points.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(low, high), p| {
+            let local = rotation.inverse() * p.coords;
+            (low.inf(&local), high.sup(&local))
+        },
+    );
+    let half = ((high - low) / 2.0).add_scalar(margin) * normalisation.scale;
+    let middle = normalisation.centre + rotation * ((low + high) / 2.0) * normalisation.scale;
+    let place = Isometry3::from_parts(
+        Translation3::from(middle),
+        UnitQuaternion::from_rotation_matrix(&rotation),
+    );
+    Node::cuboid(
+        [half.x, half.y, half.z],
+        Deformations(vec![Deformation::Rigid(place)]),
+    )
+}

@@ -1,0 +1,165 @@
+//! The starts of one supershape's recovery: where Levenberg-Marquardt begins, from each axis guess of
+//! `symmetry`. The radial cost has local minima in the turn about the axis and in the exponents, so the starts
+//! cover both: the guess's two turns with exponents that suit each, a start read from the points' middle section,
+//! and meridians round, boxy and read from the points.
+
+use nalgebra::{Point2, Point3, Rotation3, Vector3};
+
+use super::model::{self, Candidate, Frame, PARAMS};
+use super::symmetry::AxisGuess;
+use crate::geometry::supershape::formula::Superformula;
+use crate::geometry::supershape::prism::fit_prism_section;
+
+/// The start exponents n1 = n2 = n3 of r1 for the guess's two turns (see `symmetry::AxisGuess::starts`), and
+/// those of r2.
+const LOBED_STARTS: [f64; 2] = [1.2, 4.0];
+const MERIDIAN_STARTS: [f64; 2] = [2.0, 4.0];
+
+/// Where a start puts the supershape and r1, before its meridian is chosen.
+struct LobedStart {
+    rotation: Rotation3<f64>,
+    centre: Vector3<f64>,
+    sizes: [f64; 3],
+    r1: [f64; 3],
+}
+
+/// The starts from one axis guess, each with whether its symmetry numbers were read from the points:
+/// - the section start: the superformula fitted to the outline of the points' middle slab across the axis (a 2-D
+///   fit, cheap and with its own starts: `prism::fit_prism_section`) gives r1's exponents, turn, centre and size;
+/// - the guess's two turns, each with the exponents that put a lobe's maximum where that turn expects it (n < 2: in
+///   the middle of a side, n > 2: at a corner);
+///
+/// each with a round and a boxy meridian and one read from the points, for every latitude symmetry worth trying.
+pub(super) fn of(
+    points: &[Point3<f64>],
+    guess: &AxisGuess,
+    given: Option<[u32; 2]>,
+) -> Vec<(Candidate, bool)> {
+    let mut latitudes = vec![guess.symmetry[1]];
+    // A meridian's lobes are read from few points; the transparent 4 is tried beside them.
+    if given.is_none() && guess.symmetry[1] != 4 {
+        latitudes.push(4);
+    }
+    let mut lobed: Vec<LobedStart> = guess
+        .starts
+        .iter()
+        .zip(LOBED_STARTS)
+        .map(|(start, n)| LobedStart {
+            rotation: *start,
+            centre: guess.centre.coords,
+            sizes: guess.half_extents,
+            r1: [n; 3],
+        })
+        .collect();
+    if let Some(section) = middle_section(points, guess) {
+        lobed.push(section);
+    }
+    let mut starts = Vec::new();
+    for &m2 in &latitudes {
+        for start in &lobed {
+            let read = meridian_exponents(points, start, guess.symmetry[0], m2);
+            for meridian in MERIDIAN_STARTS.iter().map(|n| [*n; 3]).chain(read) {
+                let mut params = [0.0; PARAMS];
+                params[..3].copy_from_slice(start.centre.as_slice());
+                params[6..9].copy_from_slice(&start.sizes.map(f64::ln));
+                params[9..12].copy_from_slice(&start.r1.map(model::exponent_parameter));
+                params[12..].copy_from_slice(&meridian.map(model::exponent_parameter));
+                let detected = given.is_none()
+                    && guess.detected[0]
+                    && guess.detected[1]
+                    && m2 == guess.symmetry[1];
+                starts.push((
+                    Candidate {
+                        frame: Frame {
+                            symmetry: [guess.symmetry[0], m2],
+                            start: start.rotation,
+                        },
+                        params,
+                    },
+                    detected,
+                ));
+            }
+        }
+    }
+    starts
+}
+
+/// r2's exponents read from the points for a start: each point in the start's frame gives, through eq. 8 with the
+/// start's r1 and sizes, its latitude phi and the radius r2(phi) it asks for; the exponents of a coarse grid (n1 from
+/// 1 to 16, n2 and n3 from 0.7 to 12, on up to 300 points) that best give those radii. A meridian's two flanks
+/// often differ (n2 != n3), which starts with equal exponents do not reach.
+fn meridian_exponents(
+    points: &[Point3<f64>],
+    start: &LobedStart,
+    m1: u32,
+    m2: u32,
+) -> Option<[f64; 3]> {
+    let [n1, n2, n3] = start.r1;
+    let r1 = Superformula::new(f64::from(m1), n1, n2, n3, 1.0, 1.0).ok()?;
+    let sizes = start.sizes;
+    let step = points.len().div_ceil(300);
+    let samples: Vec<(f64, f64)> = points
+        .iter()
+        .step_by(step)
+        .map(|p| {
+            let local = start.rotation.inverse() * (p.coords - start.centre);
+            let u = Vector3::new(local.x / sizes[0], local.y / sizes[1], local.z / sizes[2]);
+            let radius1 = r1.radius(u.y.atan2(u.x));
+            let rho = u.x.hypot(u.y) / radius1;
+            ((u.z * radius1).atan2(u.x.hypot(u.y)), rho.hypot(u.z))
+        })
+        .collect();
+    const N1: [f64; 5] = [1.0, 2.0, 4.0, 8.0, 16.0];
+    const N23: [f64; 5] = [0.7, 1.5, 3.0, 6.0, 12.0];
+    N1.iter()
+        .flat_map(|&n1| {
+            N23.iter()
+                .flat_map(move |&n2| N23.iter().map(move |&n3| [n1, n2, n3]))
+        })
+        .map(|n| {
+            let r2 = Superformula {
+                m: f64::from(m2),
+                n1: n[0],
+                n2: n[1],
+                n3: n[2],
+                a: 1.0,
+                b: 1.0,
+            };
+            let misfit: f64 = samples
+                .iter()
+                .map(|(phi, r)| (r - r2.radius(*phi)).powi(2))
+                .sum();
+            (misfit, n)
+        })
+        .filter(|(misfit, _)| misfit.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, n)| n)
+}
+
+/// The section start of `of`: start frame, centre, sizes and r1's exponents from a superformula fitted to the
+/// points within 15% of the half height of the guess's middle plane. `None` when too few points lie there or the
+/// outline does not fit.
+fn middle_section(points: &[Point3<f64>], guess: &AxisGuess) -> Option<LobedStart> {
+    let frame = guess.starts[0];
+    let band = 0.15 * guess.half_extents[2];
+    let slab: Vec<Point2<f64>> = points
+        .iter()
+        .map(|p| frame.inverse() * (p - guess.centre))
+        .filter(|local| local.z.abs() < band)
+        .map(|local| Point2::new(local.x, local.y))
+        .collect();
+    let section = fit_prism_section(&slab, Some(guess.symmetry[0] as usize)).ok()?;
+    let turned = frame * Rotation3::from_axis_angle(&Vector3::z_axis(), section.turn);
+    let centre =
+        guess.centre.coords + frame * Vector3::new(section.centre.x, section.centre.y, 0.0);
+    let f = section.formula;
+    (f.n1 > model::SMALLEST_EXPONENT
+        && f.n2 > model::SMALLEST_EXPONENT
+        && f.n3 > model::SMALLEST_EXPONENT)
+        .then_some(LobedStart {
+            rotation: turned,
+            centre,
+            sizes: [section.size_mm, section.size_mm, guess.half_extents[2]],
+            r1: [f.n1, f.n2, f.n3],
+        })
+}
