@@ -5,6 +5,7 @@ mod control;
 pub mod demo;
 mod deviate;
 mod fit;
+mod fit_supershape;
 mod mesh;
 mod station;
 mod sweep;
@@ -69,6 +70,9 @@ enum Command {
 enum FitCommand {
     /// Fit an implicit polynomial (a profile from y,z points; a surface, or a stack of profiles, from x,y,z).
     Ip(fit::FitIpArgs),
+    /// Recover a supershape model (seed 001) from x,y,z points over a part's surface: the envelope with its symmetry
+    /// numbers, truncated by the points' bounding box, minus the holes found; distances in mm.
+    Supershape(fit_supershape::FitSupershapeArgs),
 }
 
 /// Fitting methods as the command line names them.
@@ -117,6 +121,7 @@ impl From<DistanceArg> for DistanceMethod {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
+        Command::Fit(FitCommand::Supershape(args)) => fit_supershape::run(&args),
         Command::Deviate(args) => deviate::run(&args),
         Command::Mesh(args) => mesh::run(&args),
         Command::Sweep(args) => sweep::run(&args),

@@ -9,7 +9,7 @@ use zeroset::report::PartReport;
 use zeroset_sim::config::SimConfig;
 
 use crate::daemon::Station;
-use crate::support::config;
+use crate::support::{config, zeroset};
 
 /// The agreement asked of the station between measured and true deviations, mm (as for the propeller).
 const AGREEMENT_MM: f64 = 0.005;
@@ -69,6 +69,44 @@ fn a_nut_taught_as_a_supershape_measures_the_next_nut_of_the_batch() {
     assert!(
         (size - 40.08).abs() < 0.002,
         "fitted size {size} mm, made 40.08 mm"
+    );
+
+    // The inspection's moves against the taught nut: descent, contact scan, lift-off and way out per profile.
+    let sweep = master.root.path().join("sweep");
+    let out = master.cli_ok(&["sweep", "nut", "--out", &sweep.display().to_string()]);
+    let rows: Vec<&str> = out.lines().filter(|l| l.ends_with(" ok")).collect();
+    assert!(rows.len() >= 12 && !out.contains("REFUSED"), "{out}");
+    assert!(
+        std::fs::read_to_string(sweep.join("clearance.csv"))
+            .unwrap()
+            .lines()
+            .count()
+            > rows.len()
+    );
+    assert!(std::fs::read_to_string(sweep.join("silhouette.svg"))
+        .unwrap()
+        .contains("<polyline"));
+
+    // The reference's model as a model file, meshed: closed, in mm.
+    let model = master.root.path().join("nut-model.json");
+    std::fs::write(&model, reference["model"].to_string()).expect("the model file");
+    let stl = master.root.path().join("nut.stl");
+    let meshed = zeroset(&[
+        "mesh",
+        "--model",
+        &model.display().to_string(),
+        "--out",
+        &stl.display().to_string(),
+    ]);
+    assert!(
+        meshed.success && meshed.stdout.contains(", closed,"),
+        "{}{}",
+        meshed.stdout,
+        meshed.stderr
+    );
+    assert!(
+        std::fs::metadata(&stl).unwrap().len() > 84 + 50 * 1000,
+        "a binary STL of many triangles"
     );
 
     let batch = Station::start_as("nut-b.toml", "station-nut.toml");

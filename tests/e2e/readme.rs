@@ -75,7 +75,7 @@ fn help_describes_every_command_with_units() {
     let top = zeroset_ok(&["--help"]);
     for command in [
         "fit", "deviate", "sim", "demo", "daemon", "teach", "inspect", "watch", "status", "abort",
-        "clear", "report",
+        "clear", "report", "mesh", "sweep",
     ] {
         assert!(top.contains(command), "--help lacks {command}:\n{top}");
     }
@@ -117,6 +117,22 @@ fn help_describes_every_command_with_units() {
             deviate.contains(option),
             "deviate --help lacks {option}:\n{deviate}"
         );
+    }
+    for (command, options) in [
+        (
+            "mesh",
+            &["--model", "--out", "--cell-mm", "--epsilon", "mm"][..],
+        ),
+        ("sweep", &["--config", "--eye", "--out", "mm"][..]),
+    ] {
+        let help = zeroset_ok(&[command, "--help"]);
+        for option in options {
+            assert!(
+                help.contains(option),
+                "{command} --help lacks {option}:
+{help}"
+            );
+        }
     }
     assert!(!zeroset(&["no-such-command"]).success);
 }

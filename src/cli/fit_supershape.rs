@@ -1,0 +1,117 @@
+//! `zeroset fit supershape`: recover a supershape model from measured x,y,z points (seed 001) and save it as a
+//! model file, with the exact distances of the points to it.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::bail;
+use clap::Args;
+use nalgebra::Point3;
+
+use crate::geometry::supershape::distance::SolidDistance;
+use crate::geometry::supershape::recover::{recover, RecoveryOptions};
+use crate::model_file::{ModelFile, ReferenceModel, SolidFitStats};
+use crate::points::{read_points, PointSet};
+
+#[derive(Args)]
+pub struct FitSupershapeArgs {
+    /// Point file: CSV with header x,y,z, in mm, spread over the part's surface.
+    #[arg(long)]
+    points: PathBuf,
+    /// The symmetry numbers of the two superformulas when known, "m1,m2" (a superquadric is 4,4; a hex prism
+    /// 6,4); found from the points otherwise.
+    #[arg(long, value_parser = parse_symmetry)]
+    symmetry: Option<[u32; 2]>,
+    /// Keep the whole supershape: do not cut it by the points' oriented bounding box.
+    #[arg(long)]
+    no_truncation: bool,
+    /// Do not look for holes (points well inside the envelope, fitted as negative primitives).
+    #[arg(long)]
+    no_holes: bool,
+    /// The model file to write (JSON).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn parse_symmetry(text: &str) -> Result<[u32; 2], String> {
+    let numbers: Vec<u32> = text
+        .split(',')
+        .map(|v| v.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{text:?}: {e}; give two whole numbers m1,m2"))?;
+    match numbers[..] {
+        [m1, m2] if m1 > 0 && m2 > 0 => Ok([m1, m2]),
+        _ => Err(format!(
+            "{text:?}: give two whole numbers above zero, m1,m2"
+        )),
+    }
+}
+
+pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let points: Vec<Point3<f64>> = match read_points(&args.points)? {
+        PointSet::Spatial(points) => points.into_iter().map(Point3::from).collect(),
+        PointSet::Profile(_) => bail!(
+            "{}: a supershape is recovered from x,y,z points over the part's surface; this file has y,z",
+            args.points.display()
+        ),
+    };
+    let options = RecoveryOptions {
+        symmetry: args.symmetry,
+        truncate: !args.no_truncation,
+        holes: !args.no_holes,
+    };
+    let recovered = recover(&points, &options)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
+    let stats = SolidFitStats::of(&SolidDistance::new(&recovered.solid), &points);
+    let method = format!(
+        "supershape recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry {},{} ({})",
+        recovered.starts,
+        recovered.symmetry[0],
+        recovered.symmetry[1],
+        if args.symmetry.is_some() {
+            "given"
+        } else if recovered.symmetry_detected {
+            "found from the points"
+        } else {
+            "none stood out"
+        }
+    );
+    let file = ModelFile::new(
+        method,
+        ReferenceModel::Supershape {
+            solid: recovered.solid.clone(),
+            fit: stats,
+        },
+    );
+    file.save(&args.out)?;
+    let (primitives, booleans) = recovered.solid.root().counts();
+    println!(
+        "supershape of {}: {} points, {primitives} primitives and {booleans} Booleans, symmetry {},{}, global error \
+         (eq. 15) {:.4e} mm^3",
+        args.points.display(),
+        points.len(),
+        recovered.symmetry[0],
+        recovered.symmetry[1],
+        recovered.global_error
+    );
+    let through = recovered.holes.iter().filter(|h| h.through).count();
+    println!(
+        "  envelope: RMS radial distance {:.4} mm; {} hole(s) ({through} through)",
+        recovered.rms_radial_mm,
+        recovered.holes.len()
+    );
+    match stats {
+        Some(s) => println!(
+            "  exact distances of the points: RMS {:.4} mm, max {:.4} mm",
+            s.rms_distance_mm, s.max_distance_mm
+        ),
+        None => println!("  some points have no exact distance to the model"),
+    }
+    println!(
+        "wrote {} ({:.2} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
