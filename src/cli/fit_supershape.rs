@@ -61,6 +61,12 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         truncate: !args.no_truncation,
         holes: !args.no_holes,
     };
+    // A recovery tries dozens of starts and takes seconds: say so before the wait.
+    eprintln!(
+        "recovering a supershape from {} points of {} (a few seconds)...",
+        points.len(),
+        args.points.display()
+    );
     let recovered = recover(&points, &options)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
     let stats = SolidFitStats::of(&SolidDistance::new(&recovered.solid), &points);

@@ -10,9 +10,9 @@
 
 pub mod csg;
 pub mod deform;
+pub mod differences;
 pub mod distance;
 pub mod formula;
-pub mod jacobian;
 pub mod lobes;
 pub mod mesh;
 pub mod prism;

@@ -17,19 +17,26 @@
 
 use std::f64::consts::TAU;
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{Isometry3, Matrix3, Point2, Rotation3, Translation3, UnitQuaternion};
-use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
 
 use super::deform::{Deformation, Deformations};
+use super::differences;
 use super::formula::{Superformula, SuperformulaError};
-use super::jacobian::central_differences;
 use super::lobes;
 use super::shape::Supershape;
 
 /// The exponents of the square r2 that makes a supershape a prism: the side wall is rho = r1 to within
 /// r1 tan(phi)^n / n, below 1e-20 of the size over the middle 80% of the height.
-pub(super) const SQUARE_EXPONENT: f64 = 200.0;
+const SQUARE_EXPONENT: f64 = 200.0;
+/// The square r2 of a prism.
+pub(super) const SQUARE: Superformula = Superformula {
+    m: 4.0,
+    n1: SQUARE_EXPONENT,
+    n2: SQUARE_EXPONENT,
+    n3: SQUARE_EXPONENT,
+    a: 1.0,
+    b: 1.0,
+};
 /// Symmetry numbers tried when none is given.
 const SYMMETRIES: std::ops::RangeInclusive<usize> = 2..=12;
 /// Fewer points than this cannot fix seven parameters against a machine's noise.
@@ -70,18 +77,10 @@ impl PrismSection {
     /// The prism as a supershape placed in the part frame: its axis along the part's x between `x_range`
     /// (mm), the section plane's coordinates (u, v) being the part's (y, z).
     pub fn supershape(&self, x_range: (f64, f64)) -> (Supershape, Deformations) {
-        let square = Superformula {
-            m: 4.0,
-            n1: SQUARE_EXPONENT,
-            n2: SQUARE_EXPONENT,
-            n3: SQUARE_EXPONENT,
-            a: 1.0,
-            b: 1.0,
-        };
         let half_height = (x_range.1 - x_range.0) / 2.0;
         let shape = Supershape {
             r1: self.formula,
-            r2: square,
+            r2: SQUARE,
             scale: [self.size_mm, self.size_mm, half_height],
         };
         // Canonical x, y (turned by `turn`) -> part y, z; canonical z -> part x.
@@ -127,15 +126,10 @@ pub fn fit_prism_section(
                 f64::ln(n23),
                 f64::ln(n23),
             ];
-            let problem = RadialProblem {
-                points,
-                m: m as f64,
-                params: start,
-            };
-            let (solved, report) = LevenbergMarquardt::new().minimize(problem);
-            let cost = report.objective_function;
+            let (solved, cost) =
+                differences::minimise(start, |p| radial_residuals(points, m as f64, p));
             if cost.is_finite() && best.is_none_or(|(b, _)| cost < b) {
-                best = Some((cost, solved.params));
+                best = Some((cost, solved));
             }
         }
     }
@@ -166,59 +160,28 @@ fn dominant_harmonic(points: &[Point2<f64>], centroid: &Point2<f64>) -> Option<u
     (lobes.strength > 2e-4).then_some(lobes.count)
 }
 
-/// The radial least-squares problem of the section fit, parameters
-/// [cx, cy, turn, ln size, ln n1, ln n2, ln n3].
-struct RadialProblem<'a> {
-    points: &'a [Point2<f64>],
-    m: f64,
-    params: [f64; 7],
-}
-
-impl RadialProblem<'_> {
-    fn residuals_at(&self, p: &[f64; 7]) -> Option<Vec<f64>> {
-        let formula = Superformula {
-            m: self.m,
-            n1: p[4].exp(),
-            n2: p[5].exp(),
-            n3: p[6].exp(),
-            a: 1.0,
-            b: 1.0,
-        };
-        let size = p[3].exp();
-        let residuals: Vec<f64> = self
-            .points
-            .iter()
-            .map(|q| {
-                let (dx, dy) = (q.x - p[0], q.y - p[1]);
-                dx.hypot(dy) - size * formula.radius(dy.atan2(dx) - p[2])
-            })
-            .collect();
-        residuals.iter().all(|r| r.is_finite()).then_some(residuals)
-    }
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialProblem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.params.copy_from_slice(x.as_slice());
-    }
-
-    fn params(&self) -> DVector<f64> {
-        DVector::from_column_slice(&self.params)
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.params).map(DVector::from_vec)
-    }
-
-    /// Central differences: seven parameters, and the exponents' partials of eq. 4 in closed form would
-    /// add a page of code for no measurable gain in a fit made once per teach.
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        central_differences(&self.params, |p| self.residuals_at(p))
-    }
+/// The radial residuals of the section fit, |q - c| - s r1(theta - psi) in mm, at the parameters
+/// [cx, cy, turn, ln size, ln n1, ln n2, ln n3] (a = b = 1). Its Jacobian is taken by central differences:
+/// seven parameters, and the exponents' partials of eq. 4 in closed form would add a page of code for no
+/// measurable gain in a fit made once per teach.
+fn radial_residuals(points: &[Point2<f64>], m: f64, p: &[f64; 7]) -> Option<Vec<f64>> {
+    let formula = Superformula {
+        m,
+        n1: p[4].exp(),
+        n2: p[5].exp(),
+        n3: p[6].exp(),
+        a: 1.0,
+        b: 1.0,
+    };
+    let size = p[3].exp();
+    let residuals: Vec<f64> = points
+        .iter()
+        .map(|q| {
+            let (dx, dy) = (q.x - p[0], q.y - p[1]);
+            dx.hypot(dy) - size * formula.radius(dy.atan2(dx) - p[2])
+        })
+        .collect();
+    residuals.iter().all(|r| r.is_finite()).then_some(residuals)
 }
 
 #[cfg(test)]

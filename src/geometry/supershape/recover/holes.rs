@@ -15,8 +15,7 @@ use super::model::Radius;
 use super::problem::minimise;
 use super::{fit_one, Fitted, RecoveryError, STANDARD_PATIENCE};
 use crate::geometry::supershape::deform::Deformations;
-use crate::geometry::supershape::formula::Superformula;
-use crate::geometry::supershape::prism::SQUARE_EXPONENT;
+use crate::geometry::supershape::prism::SQUARE;
 use crate::geometry::supershape::shape::Supershape;
 
 /// A point is in a cavity when F2 (its relative depth inside the envelope) is above this many robust standard
@@ -115,16 +114,8 @@ pub(super) fn through_prism(
     place: Deformations,
     length: f64,
 ) -> (Supershape, Deformations) {
-    let square = Superformula {
-        m: 4.0,
-        n1: SQUARE_EXPONENT,
-        n2: SQUARE_EXPONENT,
-        n3: SQUARE_EXPONENT,
-        a: 1.0,
-        b: 1.0,
-    };
     let mut prism = shape;
-    prism.r2 = square;
+    prism.r2 = SQUARE;
     prism.scale[2] = length;
     (prism, place)
 }

@@ -8,15 +8,13 @@
 //! the supershape decides the value, and R_p, homogeneous of degree one, keeps the zero set and signs of the
 //! tree whatever the weights.
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{Point3, Quaternion, Rotation3, UnitQuaternion, Vector3};
-use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
 
 use crate::geometry::supershape::csg::{Node, NodeKind, Solid};
 use crate::geometry::supershape::deform::Deformations;
-use crate::geometry::supershape::jacobian::central_differences;
+use crate::geometry::supershape::differences;
 use crate::geometry::supershape::shape::Supershape;
 
 /// Seed 001 eq. 15 of the points against the solid, mm^3 (the weights are in mm^(3/2), the radial values
@@ -154,83 +152,36 @@ pub struct PoseFit {
 /// the translation and the logarithm of the scale, with central differences (the tree's value is not generic over
 /// dual numbers, and seven parameters make that cheap).
 pub fn fit_pose(reference: &Solid, points: &[Point3<f64>], start: Pose) -> PoseFit {
-    let problem = PoseProblem {
-        reference,
-        points,
-        start,
-        params: [
-            0.0,
-            0.0,
-            0.0,
-            start.translation.x,
-            start.translation.y,
-            start.translation.z,
-            start.scale.ln(),
-        ],
+    let error_at = |pose: &Pose| {
+        global_error(
+            reference,
+            &points.iter().map(|p| pose.apply(p)).collect::<Vec<_>>(),
+        )
     };
-    let error_before = global_error(
-        reference,
-        &points.iter().map(|p| start.apply(p)).collect::<Vec<_>>(),
-    );
-    let (solved, _) = LevenbergMarquardt::new().minimize(problem);
-    let pose = solved.pose(&solved.params);
-    let error_after = global_error(
-        reference,
-        &points.iter().map(|p| pose.apply(p)).collect::<Vec<_>>(),
-    );
+    let t = start.translation;
+    let (solved, _) =
+        differences::minimise([0.0, 0.0, 0.0, t.x, t.y, t.z, start.scale.ln()], |p| {
+            let pose = pose_of(&start, p);
+            let values: Vec<f64> = points
+                .iter()
+                .map(|q| weighted(reference.root(), &pose.apply(q)))
+                .collect();
+            values.iter().all(|v| v.is_finite()).then_some(values)
+        });
+    let pose = pose_of(&start, &solved);
     PoseFit {
+        error_before: error_at(&start),
+        error_after: error_at(&pose),
         pose,
-        error_before,
-        error_after,
     }
 }
 
-struct PoseProblem<'a> {
-    reference: &'a Solid,
-    points: &'a [Point3<f64>],
-    start: Pose,
-    params: [f64; 7],
-}
-
-impl PoseProblem<'_> {
-    fn pose(&self, p: &[f64; 7]) -> Pose {
-        let turn = UnitQuaternion::from_quaternion(Quaternion::new(1.0, p[0], p[1], p[2]));
-        Pose {
-            rotation: turn.to_rotation_matrix() * self.start.rotation,
-            translation: Vector3::new(p[3], p[4], p[5]),
-            scale: p[6].exp(),
-        }
-    }
-
-    fn residuals_at(&self, p: &[f64; 7]) -> Option<Vec<f64>> {
-        let pose = self.pose(p);
-        let values: Vec<f64> = self
-            .points
-            .iter()
-            .map(|q| weighted(self.reference.root(), &pose.apply(q)))
-            .collect();
-        values.iter().all(|v| v.is_finite()).then_some(values)
-    }
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for PoseProblem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.params.copy_from_slice(x.as_slice());
-    }
-
-    fn params(&self) -> DVector<f64> {
-        DVector::from_column_slice(&self.params)
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        self.residuals_at(&self.params).map(DVector::from_vec)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        central_differences(&self.params, |p| self.residuals_at(p))
+/// The pose of the parameters [Gibbs vector of the turn from `start` (3), translation (3), ln scale].
+fn pose_of(start: &Pose, p: &[f64; 7]) -> Pose {
+    let turn = UnitQuaternion::from_quaternion(Quaternion::new(1.0, p[0], p[1], p[2]));
+    Pose {
+        rotation: turn.to_rotation_matrix() * start.rotation,
+        translation: Vector3::new(p[3], p[4], p[5]),
+        scale: p[6].exp(),
     }
 }
