@@ -70,18 +70,23 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
     let recovered = recover(&points, &options)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
     let stats = SolidFitStats::of(&SolidDistance::new(&recovered.solid), &points);
-    let method = format!(
-        "supershape recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry {},{} ({})",
-        recovered.starts,
-        recovered.symmetry[0],
-        recovered.symmetry[1],
+    let how = |k: usize| {
         if args.symmetry.is_some() {
             "given"
-        } else if recovered.symmetry_detected {
-            "found from the points"
+        } else if recovered.symmetry_read[k] {
+            "read from the points"
         } else {
-            "none stood out"
+            "4: nothing stood out"
         }
+    };
+    let method = format!(
+        "supershape recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), \
+         m2 = {} ({})",
+        recovered.starts,
+        recovered.symmetry[0],
+        how(0),
+        recovered.symmetry[1],
+        how(1)
     );
     let file = ModelFile::new(
         method,

@@ -6,25 +6,33 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
 
 /// Minimises the sum of squares of `residuals` from `start`; returns the parameters reached and half the sum of
-/// squares there (the crate's objective), infinite when the residuals stopped being defined.
+/// squares there (the crate's objective), infinite when the residuals are not defined there.
 pub fn minimise<const P: usize>(
     start: [f64; P],
     residuals: impl Fn(&[f64; P]) -> Option<Vec<f64>>,
 ) -> ([f64; P], f64) {
-    let (solved, report) = LevenbergMarquardt::new().minimize(Problem {
+    let Some(rows) = residuals(&start).map(|r| r.len()) else {
+        return (start, f64::INFINITY);
+    };
+    let (solved, _) = LevenbergMarquardt::new().minimize(Problem {
         params: start,
+        rows,
         residuals,
     });
-    let objective = if report.objective_function.is_finite() {
-        report.objective_function
-    } else {
-        f64::INFINITY
-    };
+    let objective = (solved.residuals)(&solved.params)
+        .map(|r| r.iter().map(|v| v * v).sum::<f64>() / 2.0)
+        .filter(|o| o.is_finite())
+        .unwrap_or(f64::INFINITY);
     (solved.params, objective)
 }
 
+/// The stand-in for a residual that is not defined at a trial step: the crate then rejects the step and stays
+/// where it was (given no residuals it would stop at the failed trial).
+const UNDEFINED: f64 = 1e6;
+
 struct Problem<const P: usize, F> {
     params: [f64; P],
+    rows: usize,
     residuals: F,
 }
 
@@ -44,7 +52,15 @@ impl<const P: usize, F: Fn(&[f64; P]) -> Option<Vec<f64>>> LeastSquaresProblem<f
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        (self.residuals)(&self.params).map(DVector::from_vec)
+        let values = (self.residuals)(&self.params)
+            .filter(|r| r.len() == self.rows)
+            .unwrap_or_else(|| vec![UNDEFINED; self.rows]);
+        Some(DVector::from_iterator(
+            self.rows,
+            values
+                .into_iter()
+                .map(|v| if v.is_finite() { v } else { UNDEFINED }),
+        ))
     }
 
     /// Each column by a central difference of step 1e-7 (1 + |parameter|).

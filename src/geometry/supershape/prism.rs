@@ -97,7 +97,8 @@ impl PrismSection {
 }
 
 /// Fits the cross section to points of parallel sections given in their plane's coordinates.
-/// `symmetry`: the number of lobes when known (a hex nut: 6), else found from the points.
+/// `symmetry`: the number of lobes when known (a hex nut: 6), else found from the points. Starts from six turns
+/// over one period, each with four exponent sets.
 pub fn fit_prism_section(
     points: &[Point2<f64>],
     symmetry: Option<usize>,
@@ -110,13 +111,45 @@ pub fn fit_prism_section(
         Some(m) => m,
         None => dominant_harmonic(points, &centroid).ok_or(PrismFitError::NoSymmetry)?,
     };
+    let period = TAU / m as f64;
+    let turns: Vec<f64> = (0..6).map(|k| period * k as f64 / 6.0).collect();
+    fit_from(
+        points,
+        m,
+        &centroid,
+        &turns,
+        &[(2.0, 2.0), (4.0, 4.0), (8.0, 4.0), (1.0, 1.0)],
+    )
+}
+
+/// The same fit from the given turns only (radians, where a lobe's maximum is expected), each with a pinched and
+/// a boxy exponent set: for a caller that has read the outline's phase already (the 3-D recovery's starts).
+pub fn fit_prism_section_from_turns(
+    points: &[Point2<f64>],
+    m: usize,
+    turns: &[f64],
+) -> Result<PrismSection, PrismFitError> {
+    if points.len() < MIN_POINTS {
+        return Err(PrismFitError::TooFewPoints { got: points.len() });
+    }
+    let centroid = lobes::circle_centre(points);
+    fit_from(points, m, &centroid, turns, &[(1.2, 1.2), (4.0, 4.0)])
+}
+
+/// Levenberg-Marquardt from every turn with every (n1, n2 = n3) start, the smallest cost kept.
+fn fit_from(
+    points: &[Point2<f64>],
+    m: usize,
+    centroid: &Point2<f64>,
+    turns: &[f64],
+    exponents: &[(f64, f64)],
+) -> Result<PrismSection, PrismFitError> {
     let mean_radius =
         points.iter().map(|p| (p - centroid).norm()).sum::<f64>() / points.len() as f64;
     let period = TAU / m as f64;
     let mut best: Option<(f64, [f64; 7])> = None;
-    for turn_step in 0..6 {
-        let turn = period * turn_step as f64 / 6.0;
-        for (n1, n23) in [(2.0, 2.0), (4.0, 4.0), (8.0, 4.0), (1.0, 1.0)] {
+    for &turn in turns {
+        for &(n1, n23) in exponents {
             let start = [
                 centroid.x,
                 centroid.y,
@@ -139,7 +172,9 @@ pub fn fit_prism_section(
     let section = PrismSection {
         formula,
         centre: Point2::new(p[0], p[1]),
-        turn: p[2].rem_euclid(period),
+        // A turn by 2 pi / m swaps the cosine and sine terms of eq. 4, so with n2 != n3 the outline repeats only
+        // every 4 pi / m.
+        turn: p[2].rem_euclid(2.0 * period),
         size_mm: p[3].exp(),
         rms_mm,
     };

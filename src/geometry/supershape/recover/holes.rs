@@ -87,8 +87,11 @@ pub(super) fn separate(
             continue;
         }
         let cavity: Vec<Point3<f64>> = cluster.iter().map(|&i| points[i]).collect();
-        // A given symmetry is the envelope's; a cavity's is read from its own points.
-        let fitted = fit_one(&cavity, None)?;
+        // A given symmetry is the envelope's; a cavity's is read from its own points. A cavity that fits no
+        // supershape is left out (its points stay set apart from the envelope's) rather than failing the part.
+        let Ok(fitted) = fit_one(&cavity, None) else {
+            continue;
+        };
         let axis = fitted.candidate.rotation() * Vector3::z();
         let span = |set: &[Point3<f64>]| {
             let along = set.iter().map(|p| p.coords.dot(&axis));

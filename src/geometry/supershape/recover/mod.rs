@@ -74,8 +74,12 @@ pub enum RecoveryError {
     TooFewPoints { got: usize },
     #[error("a point has a coordinate that is not a finite number (point {index})")]
     NotFinite { index: usize },
-    #[error("no start converged ({starts} tried); check that the points are of one part, in mm")]
+    #[error(
+        "no start converged ({starts} tried); check that the points are of one part's surface"
+    )]
     NoConvergence { starts: usize },
+    #[error("the points all lie at one place ({centre:?} mm): they do not show a surface")]
+    Coincident { centre: [f64; 3] },
 }
 
 /// A recovered solid and how it was found.
@@ -89,8 +93,8 @@ pub struct Recovered {
     pub holes: Vec<RecoveredHole>,
     /// The envelope's symmetry numbers m1, m2.
     pub symmetry: [u32; 2],
-    /// Whether both were read from the points (false when given or when one fell back to 4).
-    pub symmetry_detected: bool,
+    /// Whether each was read from the points (false when given, or when it fell back to 4).
+    pub symmetry_read: [bool; 2],
     /// The starts tried for the envelope.
     pub starts: usize,
     /// Seed 001 eq. 15 at the points, mm^3.
@@ -153,7 +157,7 @@ impl Normalisation {
 struct Fitted {
     candidate: Candidate,
     starts: usize,
-    detected: bool,
+    read: [bool; 2],
 }
 
 /// Recovers a solid from points on a part's surface (mm).
@@ -168,6 +172,11 @@ pub fn recover(
         return Err(RecoveryError::NotFinite { index });
     }
     let normalisation = Normalisation::of(points);
+    if normalisation.scale <= 1e-9 * (1.0 + normalisation.centre.norm()) {
+        return Err(RecoveryError::Coincident {
+            centre: normalisation.centre.into(),
+        });
+    }
     let unit: Vec<Point3<f64>> = points.iter().map(|p| normalisation.apply(p)).collect();
     let (envelope, outer, hole_fits) = if options.holes {
         holes::separate(&unit, options.symmetry)?
@@ -215,15 +224,16 @@ pub fn recover(
         envelope: (shape, place),
         holes,
         symmetry: envelope.candidate.frame.symmetry,
-        symmetry_detected: envelope.detected,
+        symmetry_read: envelope.read,
         starts: envelope.starts,
         rms_radial_mm: rms_radial * normalisation.scale,
         solid,
     })
 }
 
-/// One supershape fitted to normalised points: every inertia axis's guess from two turns, the rational radius on
-/// a subsample first, then the best starts refined with the superformula on every point.
+/// One supershape fitted to normalised points: every start of every inertia axis's guess minimised briefly on a
+/// subsample (the rational radius where it stands for the superformula), the best few refined with the
+/// superformula on the subsample, and the best of those refined on every point.
 ///
 /// Starts are compared by their RMS radial distance to the points, not by the cost they minimise: eq. 4's
 /// volume term a1 a2 a3 has a degenerate minimum, a supershape shrunk to a point far from the data (there F2
@@ -236,14 +246,14 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
     } else {
         points.to_vec()
     };
-    let starts: Vec<(Candidate, bool)> = symmetry::guesses(points, given)
+    let starts: Vec<(Candidate, [bool; 2])> = symmetry::guesses(points, given)
         .iter()
         .flat_map(|guess| starts::of(points, guess, given))
         .collect();
-    let tried_starts = starts.len();
-    let mut tried: Vec<(f64, Candidate, bool)> = starts
+    let count = starts.len();
+    let mut tried: Vec<(f64, Candidate, [bool; 2])> = starts
         .into_iter()
-        .filter_map(|(candidate, detected)| {
+        .filter_map(|(candidate, read)| {
             // Seed 001 section 4: the rational form stands for the superformula only for exponents in [1, 4];
             // a start outside (read from the points) goes straight to the superformula.
             let radius = if candidate
@@ -257,28 +267,26 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
             };
             let (reached, _) = minimise(&early, candidate, radius, RATIONAL_PATIENCE)?;
             let distance = rms_radial(&reached, &early);
-            distance
-                .is_finite()
-                .then_some((distance, reached, detected))
+            distance.is_finite().then_some((distance, reached, read))
         })
         .collect();
-    let starts = tried_starts;
     tried.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (_, best, detected) = tried
+    let (_, best, read) = tried
         .into_iter()
         .take(REFINED_STARTS)
-        .filter_map(|(_, candidate, detected)| {
+        .filter_map(|(_, candidate, read)| {
             let (reached, _) = minimise(&early, candidate, Radius::Standard, STANDARD_PATIENCE)?;
-            Some((rms_distance(&reached, &early), reached, detected))
+            let distance = rms_distance(&reached, &early);
+            distance.is_finite().then_some((distance, reached, read))
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))
-        .ok_or(RecoveryError::NoConvergence { starts })?;
+        .ok_or(RecoveryError::NoConvergence { starts: count })?;
     let (candidate, _) = minimise(points, best, Radius::Standard, STANDARD_PATIENCE)
-        .ok_or(RecoveryError::NoConvergence { starts })?;
+        .ok_or(RecoveryError::NoConvergence { starts: count })?;
     Ok(Fitted {
         candidate,
-        starts,
-        detected,
+        starts: count,
+        read,
     })
 }
 

@@ -9,8 +9,8 @@ use num_dual::DualSVec64;
 use super::model::{residual, Candidate, Radius, PARAMS};
 
 /// Minimises a1 a2 a3 sum F2^2 over the candidate's parameters from where it stands, with the given radius and
-/// at most `patience` x 16 evaluations. Returns the candidate reached and its cost (the sum of squares), or
-/// `None` when the residuals stopped being finite (a start far outside the points' region).
+/// at most `patience` x 16 evaluations. Returns the candidate reached and its cost (the sum of squares there), or
+/// `None` when the cost is not finite there.
 pub fn minimise(
     points: &[Point3<f64>],
     start: Candidate,
@@ -22,13 +22,18 @@ pub fn minimise(
         radius,
         at: start,
     };
-    let (solved, report) = LevenbergMarquardt::new()
+    let (solved, _) = LevenbergMarquardt::new()
         .with_patience(patience)
         .minimize(problem);
-    // The crate's objective is half the sum of squares.
-    let cost = 2.0 * report.objective_function;
+    let cost: f64 = points
+        .iter()
+        .map(|p| residual(&solved.at.frame, radius, &solved.at.params, p).powi(2))
+        .sum();
     cost.is_finite().then_some((solved.at, cost))
 }
+
+/// The stand-in for a residual that is not defined: far above any F2 of a point near its supershape.
+pub const UNDEFINED: f64 = 1e6;
 
 struct RadialCost<'a> {
     points: &'a [Point3<f64>],
@@ -49,16 +54,21 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialCost<'_> {
         DVector::from_column_slice(&self.at.params)
     }
 
+    /// A residual that is not finite (a trial step into exponents where the radius overflows) counts as
+    /// `UNDEFINED`, so that the crate rejects the step and stays where it was; given no residuals at all it
+    /// would stop at the failed trial.
     fn residuals(&self) -> Option<DVector<f64>> {
-        let values: Vec<f64> = self
-            .points
-            .iter()
-            .map(|p| residual(&self.at.frame, self.radius, &self.at.params, p))
-            .collect();
-        values
-            .iter()
-            .all(|v| v.is_finite())
-            .then(|| DVector::from_vec(values))
+        Some(DVector::from_iterator(
+            self.points.len(),
+            self.points.iter().map(|p| {
+                let value = residual(&self.at.frame, self.radius, &self.at.params, p);
+                if value.is_finite() {
+                    value
+                } else {
+                    UNDEFINED
+                }
+            }),
+        ))
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {

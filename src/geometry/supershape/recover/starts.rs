@@ -8,12 +8,15 @@ use nalgebra::{Point2, Point3, Rotation3, Vector3};
 use super::model::{self, Candidate, Frame, PARAMS};
 use super::symmetry::AxisGuess;
 use crate::geometry::supershape::formula::Superformula;
-use crate::geometry::supershape::prism::fit_prism_section;
+use crate::geometry::supershape::prism::fit_prism_section_from_turns;
 
 /// The start exponents n1 = n2 = n3 of r1 for the guess's two turns (see `symmetry::AxisGuess::starts`), and
 /// those of r2.
 const LOBED_STARTS: [f64; 2] = [1.2, 4.0];
 const MERIDIAN_STARTS: [f64; 2] = [2.0, 4.0];
+
+/// The middle section's fit and the meridian's reading use at most this many points (evenly taken).
+const SECTION_POINTS: usize = 200;
 
 /// Where a start puts the supershape and r1, before its meridian is chosen.
 struct LobedStart {
@@ -23,7 +26,7 @@ struct LobedStart {
     r1: [f64; 3],
 }
 
-/// The starts from one axis guess, each with whether its symmetry numbers were read from the points:
+/// The starts from one axis guess, each with whether each of its symmetry numbers was read from the points:
 /// - the section start: the superformula fitted to the outline of the points' middle slab across the axis (a 2-D
 ///   fit, cheap and with its own starts: `prism::fit_prism_section`) gives r1's exponents, turn, centre and size;
 /// - the guess's two turns, each with the exponents that put a lobe's maximum where that turn expects it (n < 2: in
@@ -34,7 +37,7 @@ pub(super) fn of(
     points: &[Point3<f64>],
     guess: &AxisGuess,
     given: Option<[u32; 2]>,
-) -> Vec<(Candidate, bool)> {
+) -> Vec<(Candidate, [bool; 2])> {
     let mut latitudes = vec![guess.symmetry[1]];
     // A meridian's lobes are read from few points; the transparent 4 is tried beside them.
     if given.is_none() && guess.symmetry[1] != 4 {
@@ -57,17 +60,17 @@ pub(super) fn of(
     let mut starts = Vec::new();
     for &m2 in &latitudes {
         for start in &lobed {
-            let read = meridian_exponents(points, start, guess.symmetry[0], m2);
-            for meridian in MERIDIAN_STARTS.iter().map(|n| [*n; 3]).chain(read) {
+            let meridian_read = meridian_exponents(points, start, guess.symmetry[0], m2);
+            for meridian in MERIDIAN_STARTS.iter().map(|n| [*n; 3]).chain(meridian_read) {
                 let mut params = [0.0; PARAMS];
                 params[..3].copy_from_slice(start.centre.as_slice());
                 params[6..9].copy_from_slice(&start.sizes.map(f64::ln));
                 params[9..12].copy_from_slice(&start.r1.map(model::exponent_parameter));
                 params[12..].copy_from_slice(&meridian.map(model::exponent_parameter));
-                let detected = given.is_none()
-                    && guess.detected[0]
-                    && guess.detected[1]
-                    && m2 == guess.symmetry[1];
+                let read = [
+                    given.is_none() && guess.detected[0],
+                    given.is_none() && guess.detected[1] && m2 == guess.symmetry[1],
+                ];
                 starts.push((
                     Candidate {
                         frame: Frame {
@@ -76,7 +79,7 @@ pub(super) fn of(
                         },
                         params,
                     },
-                    detected,
+                    read,
                 ));
             }
         }
@@ -86,7 +89,7 @@ pub(super) fn of(
 
 /// r2's exponents read from the points for a start: each point in the start's frame gives, through eq. 8 with the
 /// start's r1 and sizes, its latitude phi and the radius r2(phi) it asks for; the exponents of a coarse grid (n1 from
-/// 1 to 16, n2 and n3 from 0.7 to 12, on up to 300 points) that best give those radii. A meridian's two flanks
+/// 1 to 16, n2 and n3 from 0.7 to 12, on up to `SECTION_POINTS` points) that best give those radii. A meridian's two flanks
 /// often differ (n2 != n3), which starts with equal exponents do not reach.
 fn meridian_exponents(
     points: &[Point3<f64>],
@@ -97,7 +100,7 @@ fn meridian_exponents(
     let [n1, n2, n3] = start.r1;
     let r1 = Superformula::new(f64::from(m1), n1, n2, n3, 1.0, 1.0).ok()?;
     let sizes = start.sizes;
-    let step = points.len().div_ceil(300);
+    let step = points.len().div_ceil(SECTION_POINTS);
     let samples: Vec<(f64, f64)> = points
         .iter()
         .step_by(step)
@@ -148,7 +151,12 @@ fn middle_section(points: &[Point3<f64>], guess: &AxisGuess) -> Option<LobedStar
         .filter(|local| local.z.abs() < band)
         .map(|local| Point2::new(local.x, local.y))
         .collect();
-    let section = fit_prism_section(&slab, Some(guess.symmetry[0] as usize)).ok()?;
+    // The lobes' phase is known: the section is fitted from the guess's two turns (in its first start's frame).
+    let m = guess.symmetry[0] as usize;
+    let turns = [0.0, std::f64::consts::PI / m as f64];
+    let step = slab.len().div_ceil(SECTION_POINTS);
+    let thinned: Vec<Point2<f64>> = slab.into_iter().step_by(step).collect();
+    let section = fit_prism_section_from_turns(&thinned, m, &turns).ok()?;
     let turned = frame * Rotation3::from_axis_angle(&Vector3::z_axis(), section.turn);
     let centre =
         guess.centre.coords + frame * Vector3::new(section.centre.x, section.centre.y, 0.0);
