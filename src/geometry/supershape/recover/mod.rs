@@ -19,6 +19,7 @@ mod symmetry;
 mod tests;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use rayon::prelude::*;
 
 use self::model::{Candidate, Radius};
 use self::problem::minimise;
@@ -247,12 +248,13 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
         points.to_vec()
     };
     let starts: Vec<(Candidate, [bool; 2])> = symmetry::guesses(points, given)
-        .iter()
-        .flat_map(|guess| starts::of(points, guess, given))
+        .par_iter()
+        .flat_map_iter(|guess| starts::of(points, guess, given))
         .collect();
     let count = starts.len();
+    // The starts are independent: they are minimised on every core (rayon keeps their order).
     let mut tried: Vec<(f64, Candidate, [bool; 2])> = starts
-        .into_iter()
+        .into_par_iter()
         .filter_map(|(candidate, read)| {
             // Seed 001 section 4: the rational form stands for the superformula only for exponents in [1, 4];
             // a start outside (read from the points) goes straight to the superformula.
@@ -271,9 +273,9 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
         })
         .collect();
     tried.sort_by(|a, b| a.0.total_cmp(&b.0));
+    tried.truncate(REFINED_STARTS);
     let (_, best, read) = tried
-        .into_iter()
-        .take(REFINED_STARTS)
+        .into_par_iter()
         .filter_map(|(_, candidate, read)| {
             let (reached, _) = minimise(&early, candidate, Radius::Standard, STANDARD_PATIENCE)?;
             let distance = rms_distance(&reached, &early);
