@@ -27,8 +27,9 @@ pub fn minimise<const P: usize>(
 }
 
 /// The stand-in for a residual that is not defined at a trial step: the crate then rejects the step and stays
-/// where it was (given no residuals it would stop at the failed trial).
-const UNDEFINED: f64 = 1e6;
+/// where it was (given no residuals it would stop at the failed trial). Far above any residual of these fits near
+/// their solution.
+pub const UNDEFINED: f64 = 1e6;
 
 struct Problem<const P: usize, F> {
     params: [f64; P],

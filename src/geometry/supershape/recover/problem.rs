@@ -7,6 +7,7 @@ use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
 use num_dual::DualSVec64;
 
 use super::model::{residual, Candidate, Radius, PARAMS};
+use crate::geometry::supershape::differences::UNDEFINED;
 
 /// Minimises a1 a2 a3 sum F2^2 over the candidate's parameters from where it stands, with the given radius and
 /// at most `patience` x 16 evaluations. Returns the candidate reached and its cost (the sum of squares there), or
@@ -31,9 +32,6 @@ pub fn minimise(
         .sum();
     cost.is_finite().then_some((solved.at, cost))
 }
-
-/// The stand-in for a residual that is not defined: far above any F2 of a point near its supershape.
-pub const UNDEFINED: f64 = 1e6;
 
 struct RadialCost<'a> {
     points: &'a [Point3<f64>],
