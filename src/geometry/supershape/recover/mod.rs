@@ -294,8 +294,8 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
 
 /// The radial distance |P - I| = |P| |F2| / (1 - F2) of a point to a placed supershape, I the surface point on
 /// the ray from the supershape's centre through P: an upper bound of the Euclidean distance (I is on the
-/// surface) that costs one evaluation of eq. 3, for comparing starts and judging recoveries.
-pub fn radial_distance(shape: &Supershape, place: &Deformations, p: &Point3<f64>) -> f64 {
+/// surface) that costs one evaluation of eq. 3, for comparing starts.
+fn radial_distance(shape: &Supershape, place: &Deformations, p: &Point3<f64>) -> f64 {
     let q = place.inverse(p);
     let f = shape.radial(&q);
     q.coords.norm() * f.abs() / (1.0 - f)
