@@ -9,7 +9,7 @@ use clap::Args;
 use nalgebra::Point3;
 
 use crate::geometry::supershape::distance::SolidDistance;
-use crate::geometry::supershape::recover::{recover, RecoveryOptions};
+use crate::geometry::supershape::recover::{recover, Family, RecoveryOptions};
 use crate::model_file::{ModelFile, ReferenceModel, SolidFitStats};
 use crate::points::{read_points, PointSet};
 
@@ -20,8 +20,12 @@ pub struct FitSupershapeArgs {
     points: PathBuf,
     /// The symmetry numbers of the two superformulas when known, "m1,m2" (a superquadric is 4,4; a hex prism
     /// 6,4); found from the points otherwise.
-    #[arg(long, value_parser = parse_symmetry)]
+    #[arg(long, value_parser = parse_symmetry, conflicts_with = "superquadric")]
     symmetry: Option<[u32; 2]>,
+    /// Fit a superquadric (m1 = m2 = 4, each superformula's exponents equal: 11 parameters, epsilon1 along the
+    /// axis, epsilon2 across it) instead of a general supershape.
+    #[arg(long)]
+    superquadric: bool,
     /// Keep the whole supershape: do not cut it by the points' oriented bounding box.
     #[arg(long)]
     no_truncation: bool,
@@ -56,14 +60,25 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
             args.points.display()
         ),
     };
+    let family = if args.superquadric {
+        Family::Superquadric
+    } else {
+        Family::Supershape
+    };
     let options = RecoveryOptions {
+        family,
         symmetry: args.symmetry,
         truncate: !args.no_truncation,
         holes: !args.no_holes,
     };
     // A recovery tries dozens of starts and takes seconds: say so before the wait.
     eprintln!(
-        "recovering a supershape from {} points of {} (a few seconds)...",
+        "recovering a {} from {} points of {} (a few seconds)...",
+        if args.superquadric {
+            "superquadric"
+        } else {
+            "supershape"
+        },
         points.len(),
         args.points.display()
     );
@@ -71,7 +86,7 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
     let stats = SolidFitStats::of(&SolidDistance::new(&recovered.solid), &points);
     let how = |k: usize| {
-        if args.symmetry.is_some() {
+        if args.symmetry.is_some() || args.superquadric {
             "given"
         } else if recovered.symmetry_read[k] {
             "read from the points"
@@ -80,8 +95,9 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         }
     };
     let method = format!(
-        "supershape recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), \
+        "{} recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), \
          m2 = {} ({})",
+        if args.superquadric { "superquadric" } else { "supershape" },
         recovered.starts,
         recovered.symmetry[0],
         how(0),
@@ -106,6 +122,17 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         recovered.symmetry[1],
         recovered.global_error
     );
+    if args.superquadric {
+        let (shape, _) = &recovered.envelope;
+        println!(
+            "  superquadric: sizes {:.4}, {:.4}, {:.4} mm, epsilon1 {:.4} (along its axis), epsilon2 {:.4} (across)",
+            shape.scale[0],
+            shape.scale[1],
+            shape.scale[2],
+            2.0 / shape.r2.n1,
+            2.0 / shape.r1.n1
+        );
+    }
     let through = recovered.holes.iter().filter(|h| h.through).count();
     println!(
         "  envelope: RMS radial distance {:.4} mm; {} hole(s) ({through} through)",

@@ -270,3 +270,89 @@ fn a_supershape_recovered_from_3d_points_measures_an_offset_surface() {
         values.iter().fold(0.0f64, |m, d| m.max((d - 0.25).abs()))
     );
 }
+
+/// A rounded box, the superquadric epsilon1 = 0.4 (along z), epsilon2 = 0.6 (across), half sizes 30 x 20 x 12 mm,
+/// turned and moved off the origin: x = a1 C(eta)^e1 C(omega)^e2 and so on, C the signed power of the cosine.
+fn superquadric_csv(path: &std::path::Path, count: usize) {
+    let signed = |t: f64, e: f64| t.signum() * t.abs().powf(e);
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let (e1, e2) = (0.4, 0.6);
+    let (cos_t, sin_t) = (0.5f64.cos(), 0.5f64.sin());
+    let mut text = String::from("x,y,z\n");
+    for i in 0..count {
+        let eta = (1.0 - 2.0 * (i as f64 + 0.5) / count as f64).asin();
+        let omega = golden * i as f64;
+        let x = 30.0 * signed(eta.cos(), e1) * signed(omega.cos(), e2);
+        let y = 20.0 * signed(eta.cos(), e1) * signed(omega.sin(), e2);
+        let z = 12.0 * signed(eta.sin(), e1);
+        // A turn of 0.5 rad about x, then 100, -50, 25 mm off the origin.
+        let p = [
+            100.0 + x,
+            -50.0 + cos_t * y - sin_t * z,
+            25.0 + sin_t * y + cos_t * z,
+        ];
+        text.push_str(&format!("{:.6},{:.6},{:.6}\n", p[0], p[1], p[2]));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// `zeroset fit supershape --superquadric` fits the 11-parameter family: it prints the rounded box's sizes and
+/// exponents, and the model's exact distances to its own points are at the print's rounding; symmetry numbers
+/// other than a superquadric's are refused.
+#[test]
+fn a_superquadric_is_recovered_with_its_sizes_and_exponents() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("box.csv");
+    superquadric_csv(&points, 2000);
+    let model = dir.path().join("box.json");
+    let printed = crate::support::zeroset_ok(&[
+        "fit",
+        "supershape",
+        "--superquadric",
+        "--no-truncation",
+        "--no-holes",
+        "--points",
+        points.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    let line = printed
+        .lines()
+        .find(|l| l.contains("superquadric: sizes"))
+        .unwrap_or_else(|| panic!("{printed}"));
+    let numbers: Vec<f64> = line
+        .replace("epsilon1", "")
+        .replace("epsilon2", "")
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|t| t.parse().ok())
+        .collect();
+    let expected = [30.0, 20.0, 12.0, 0.4, 0.6];
+    for (got, want) in numbers.iter().zip(expected) {
+        assert!((got - want).abs() < 1e-3 * want.max(1.0), "{line}");
+    }
+    assert_eq!(numbers.len(), 5, "three sizes and two exponents: {line}");
+    assert!(printed.contains("symmetry 4,4"), "{printed}");
+    let rms: f64 = printed
+        .split("exact distances of the points: RMS ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{printed}"));
+    assert!(rms < 1e-3, "RMS {rms} mm for exact points: {printed}");
+    let refused = crate::support::zeroset(&[
+        "fit",
+        "supershape",
+        "--superquadric",
+        "--symmetry",
+        "6,4",
+        "--points",
+        points.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        !refused.success && refused.stderr.contains("--symmetry"),
+        "{}",
+        refused.stderr
+    );
+}

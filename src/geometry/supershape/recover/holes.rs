@@ -11,9 +11,7 @@
 
 use nalgebra::{Point3, Vector3};
 
-use super::model::Radius;
-use super::problem::minimise;
-use super::{fit_one, Fitted, RecoveryError, STANDARD_PATIENCE};
+use super::{fit_one, Envelope, Fitted, RecoveryError};
 use crate::geometry::supershape::deform::Deformations;
 use crate::geometry::supershape::prism::SQUARE;
 use crate::geometry::supershape::shape::Supershape;
@@ -47,27 +45,22 @@ pub(super) struct HoleFit {
 /// envelope is fitted to every point.
 pub(super) fn separate(
     points: &[Point3<f64>],
-    given: Option<[u32; 2]>,
+    model: Envelope,
 ) -> Result<(Fitted, Vec<usize>, Vec<HoleFit>), RecoveryError> {
     let least = MIN_HOLE_POINTS.max(points.len() / 100);
     let all: Vec<usize> = (0..points.len()).collect();
     let shell: Vec<Point3<f64>> = outer_shell(points).iter().map(|&i| points[i]).collect();
-    let mut envelope = fit_one(&shell, given)?;
+    let mut envelope = model.fit(&shell)?;
     let mut inner = interior(&envelope, points);
     if inner.len() < least {
-        return Ok((fit_one(points, given)?, all, Vec::new()));
+        return Ok((model.fit(points)?, all, Vec::new()));
     }
     for _ in 0..ROUNDS {
         let outer: Vec<Point3<f64>> = complement(&inner, points.len())
             .iter()
             .map(|&i| points[i])
             .collect();
-        if let Some((candidate, _)) = minimise(
-            &outer,
-            envelope.candidate,
-            Radius::Standard,
-            STANDARD_PATIENCE,
-        ) {
+        if let Some(candidate) = model.refine(&outer, &envelope.candidate) {
             envelope.candidate = candidate;
         }
         let next = interior(&envelope, points);
@@ -77,7 +70,7 @@ pub(super) fn separate(
         inner = next;
     }
     if inner.len() < least {
-        return Ok((fit_one(points, given)?, all, Vec::new()));
+        return Ok((model.fit(points)?, all, Vec::new()));
     }
     let outer = complement(&inner, points.len());
     let outer_points: Vec<Point3<f64>> = outer.iter().map(|&i| points[i]).collect();
@@ -87,7 +80,7 @@ pub(super) fn separate(
             continue;
         }
         let cavity: Vec<Point3<f64>> = cluster.iter().map(|&i| points[i]).collect();
-        // A given symmetry is the envelope's; a cavity's is read from its own points. A cavity that fits no
+        // The envelope's family and symmetry are its own; a cavity's are read from its points. A cavity that fits no
         // supershape is left out (its points stay set apart from the envelope's) rather than failing the part.
         let Ok(fitted) = fit_one(&cavity, None) else {
             continue;

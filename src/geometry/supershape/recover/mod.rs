@@ -13,6 +13,7 @@ mod model;
 mod problem;
 mod similarity;
 mod starts;
+mod superquadric;
 mod symmetry;
 
 #[cfg(test)]
@@ -47,9 +48,21 @@ const REFINED_STARTS: usize = 4;
 const BOX_MARGIN_RMS: f64 = 4.0;
 const BOX_MARGIN_MIN: f64 = 0.005;
 
+/// The shapes the envelope is recovered among.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Family {
+    /// Supershapes (15 parameters), their symmetry numbers given or read from the points.
+    #[default]
+    Supershape,
+    /// Superquadrics (11 parameters): supershapes with m1 = m2 = 4 and each superformula's exponents equal,
+    /// n = 2 / epsilon; the family of superquadric fitters such as EMS.
+    Superquadric,
+}
+
 /// What the recovery may assume and do.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecoveryOptions {
+    pub family: Family,
     /// The symmetry numbers m1, m2 when known (a superquadric is 4, 4); read from the points otherwise.
     pub symmetry: Option<[u32; 2]>,
     /// Cut the envelope by the oriented bounding box of its points (seed 001 eq. 14).
@@ -61,6 +74,7 @@ pub struct RecoveryOptions {
 impl Default for RecoveryOptions {
     fn default() -> Self {
         Self {
+            family: Family::Supershape,
             symmetry: None,
             truncate: true,
             holes: true,
@@ -81,6 +95,8 @@ pub enum RecoveryError {
     NoConvergence { starts: usize },
     #[error("the points all lie at one place ({centre:?} mm): they do not show a surface")]
     Coincident { centre: [f64; 3] },
+    #[error("a superquadric has the symmetry numbers 4,4, not {}; give no symmetry numbers with it", .given.map(|m| m.to_string()).join(","))]
+    SuperquadricSymmetry { given: [u32; 2] },
 }
 
 /// A recovered solid and how it was found.
@@ -178,12 +194,22 @@ pub fn recover(
             centre: normalisation.centre.into(),
         });
     }
+    let model = match (options.family, options.symmetry) {
+        (Family::Supershape, given) => Envelope::Supershape(given),
+        (Family::Superquadric, None) => Envelope::Superquadric,
+        (Family::Superquadric, Some(given)) if given == superquadric::SYMMETRY => {
+            Envelope::Superquadric
+        }
+        (Family::Superquadric, Some(given)) => {
+            return Err(RecoveryError::SuperquadricSymmetry { given })
+        }
+    };
     let unit: Vec<Point3<f64>> = points.iter().map(|p| normalisation.apply(p)).collect();
     let (envelope, outer, hole_fits) = if options.holes {
-        holes::separate(&unit, options.symmetry)?
+        holes::separate(&unit, model)?
     } else {
         let outer: Vec<usize> = (0..unit.len()).collect();
-        (fit_one(&unit, options.symmetry)?, outer, Vec::new())
+        (model.fit(&unit)?, outer, Vec::new())
     };
     let outer_points: Vec<Point3<f64>> = outer.iter().map(|&i| unit[i]).collect();
     let rms_radial = rms_radial(&envelope.candidate, &outer_points);
@@ -232,6 +258,45 @@ pub fn recover(
     })
 }
 
+/// The model of an envelope.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Envelope {
+    /// A supershape, with its symmetry numbers when given.
+    Supershape(Option<[u32; 2]>),
+    Superquadric,
+}
+
+impl Envelope {
+    /// The envelope fitted to normalised points.
+    fn fit(self, points: &[Point3<f64>]) -> Result<Fitted, RecoveryError> {
+        match self {
+            Envelope::Supershape(given) => fit_one(points, given),
+            Envelope::Superquadric => superquadric::fit(points),
+        }
+    }
+
+    /// A fitted envelope minimised on other points from where it stands, in its family.
+    fn refine(self, points: &[Point3<f64>], from: &Candidate) -> Option<Candidate> {
+        match self {
+            Envelope::Supershape(_) => {
+                minimise(points, *from, Radius::Standard, STANDARD_PATIENCE).map(|(c, _)| c)
+            }
+            Envelope::Superquadric => superquadric::refine(points, from),
+        }
+    }
+}
+
+/// At most `count` of the points, evenly taken.
+fn evenly(points: &[Point3<f64>], count: usize) -> Vec<Point3<f64>> {
+    if points.len() > count {
+        (0..count)
+            .map(|k| points[k * points.len() / count])
+            .collect()
+    } else {
+        points.to_vec()
+    }
+}
+
 /// One supershape fitted to normalised points: every start of every inertia axis's guess minimised briefly on a
 /// subsample (the rational radius where it stands for the superformula), the best few refined with the
 /// superformula on the subsample, and the best of those refined on every point.
@@ -240,13 +305,7 @@ pub fn recover(
 /// volume term a1 a2 a3 has a degenerate minimum, a supershape shrunk to a point far from the data (there F2
 /// grows like 1 / a while the weight falls like a^3), which a start in the wrong basin can slide into.
 fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, RecoveryError> {
-    let early: Vec<Point3<f64>> = if points.len() > EARLY_POINTS {
-        (0..EARLY_POINTS)
-            .map(|k| points[k * points.len() / EARLY_POINTS])
-            .collect()
-    } else {
-        points.to_vec()
-    };
+    let early = evenly(points, EARLY_POINTS);
     let starts: Vec<(Candidate, [bool; 2])> = symmetry::guesses(points, given)
         .par_iter()
         .flat_map_iter(|guess| starts::of(points, guess, given))

@@ -103,20 +103,21 @@ pub fn residual<T>(frame: &Frame, radius: Radius, params: &[T; PARAMS], point: &
 where
     T: DualNum<Primitive = f64> + Copy,
 {
-    let q = canonical(frame, params, point);
+    let q = canonical(&frame.start, params, point);
     let value = radial(frame.symmetry, radius, params, &q);
     let log_volume = params[6] + params[7] + params[8];
     (log_volume * 0.5).exp() * value
 }
 
-/// The point in the supershape's unscaled canonical frame: q_i = (R^T (P - c))_i / a_i.
-fn canonical<T>(frame: &Frame, p: &[T; PARAMS], point: &Point3<f64>) -> [T; 3]
+/// The point in the unscaled canonical frame of a shape whose first nine parameters are its centre, its turn
+/// from `start` as a Gibbs vector and the logarithms of its sizes: q_i = (R^T (P - c))_i / a_i.
+pub(super) fn canonical<T>(start: &Rotation3<f64>, p: &[T], point: &Point3<f64>) -> [T; 3]
 where
     T: DualNum<Primitive = f64> + Copy,
 {
     let d = [-p[0] + point.x, -p[1] + point.y, -p[2] + point.z];
     // Into the start frame: its columns are the canonical axes in the points' frame.
-    let start = frame.start.matrix();
+    let start = start.matrix();
     let e: [T; 3] =
         std::array::from_fn(|i| d[0] * start[(0, i)] + d[1] * start[(1, i)] + d[2] * start[(2, i)]);
     // Then by the transpose of the Gibbs rotation, the quaternion (w, x, y, z) = (1, g).

@@ -1,13 +1,36 @@
-//! The least-squares problem of one supershape's recovery for the levenberg-marquardt crate: the residuals of
-//! seed 001 eq. 4 at every point, and their Jacobian from dual numbers (exact, one pass per point).
+//! The least-squares problem of a recovery for the levenberg-marquardt crate: the residuals of seed 001 eq. 4
+//! at every point, and their Jacobian from dual numbers (exact, one pass per point). It serves any model whose
+//! residual is written once, generically over the number type: the supershape and its superquadric special case.
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{Const, Point3, U1};
 use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
-use num_dual::DualSVec64;
+use num_dual::{DualNum, DualSVec64};
 
 use super::model::{residual, Candidate, Radius, PARAMS};
 use crate::geometry::supershape::differences::UNDEFINED;
+
+/// A model's residual at one point as a function of its `N` parameters, for f64 and for dual numbers alike.
+pub trait Residual<const N: usize> {
+    fn residual<T>(&self, params: &[T; N], point: &Point3<f64>) -> T
+    where
+        T: DualNum<Primitive = f64> + Copy;
+}
+
+/// The supershape with one radius and frame (`model::residual`).
+struct Supershape {
+    candidate: Candidate,
+    radius: Radius,
+}
+
+impl Residual<PARAMS> for Supershape {
+    fn residual<T>(&self, params: &[T; PARAMS], point: &Point3<f64>) -> T
+    where
+        T: DualNum<Primitive = f64> + Copy,
+    {
+        residual(&self.candidate.frame, self.radius, params, point)
+    }
+}
 
 /// Minimises a1 a2 a3 sum F2^2 over the candidate's parameters from where it stands, with the given radius and
 /// at most `patience` x 16 evaluations. Returns the candidate reached and its cost (the sum of squares there), or
@@ -18,9 +41,31 @@ pub fn minimise(
     radius: Radius,
     patience: usize,
 ) -> Option<(Candidate, f64)> {
-    let problem = RadialCost {
-        points,
+    let model = Supershape {
+        candidate: start,
         radius,
+    };
+    let (params, cost) = minimise_model(points, &model, start.params, patience)?;
+    Some((
+        Candidate {
+            frame: start.frame,
+            params,
+        },
+        cost,
+    ))
+}
+
+/// Minimises the sum of a model's squared residuals from `start`, with at most `patience` x (N + 1)
+/// evaluations; the parameters reached and the sum there, `None` when it is not finite.
+pub fn minimise_model<M: Residual<N>, const N: usize>(
+    points: &[Point3<f64>],
+    model: &M,
+    start: [f64; N],
+    patience: usize,
+) -> Option<([f64; N], f64)> {
+    let problem = SquaredResiduals {
+        points,
+        model,
         at: start,
     };
     let (solved, _) = LevenbergMarquardt::new()
@@ -28,28 +73,30 @@ pub fn minimise(
         .minimize(problem);
     let cost: f64 = points
         .iter()
-        .map(|p| residual(&solved.at.frame, radius, &solved.at.params, p).powi(2))
+        .map(|p| model.residual(&solved.at, p).powi(2))
         .sum();
     cost.is_finite().then_some((solved.at, cost))
 }
 
-struct RadialCost<'a> {
+struct SquaredResiduals<'a, M, const N: usize> {
     points: &'a [Point3<f64>],
-    radius: Radius,
-    at: Candidate,
+    model: &'a M,
+    at: [f64; N],
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialCost<'_> {
+impl<M: Residual<N>, const N: usize> LeastSquaresProblem<f64, Dyn, Dyn>
+    for SquaredResiduals<'_, M, N>
+{
     type ResidualStorage = Owned<f64, Dyn>;
     type JacobianStorage = Owned<f64, Dyn, Dyn>;
     type ParameterStorage = Owned<f64, Dyn>;
 
     fn set_params(&mut self, x: &DVector<f64>) {
-        self.at.params.copy_from_slice(x.as_slice());
+        self.at.copy_from_slice(x.as_slice());
     }
 
     fn params(&self) -> DVector<f64> {
-        DVector::from_column_slice(&self.at.params)
+        DVector::from_column_slice(&self.at)
     }
 
     /// A residual that is not finite (a trial step into exponents where the radius overflows) counts as
@@ -59,7 +106,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialCost<'_> {
         Some(DVector::from_iterator(
             self.points.len(),
             self.points.iter().map(|p| {
-                let value = residual(&self.at.frame, self.radius, &self.at.params, p);
+                let value = self.model.residual(&self.at, p);
                 if value.is_finite() {
                     value
                 } else {
@@ -70,13 +117,13 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for RadialCost<'_> {
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let duals: [DualSVec64<PARAMS>; PARAMS] =
-            std::array::from_fn(|j| DualSVec64::from_re(self.at.params[j]).derivative(j));
-        let mut jacobian = DMatrix::zeros(self.points.len(), PARAMS);
+        let duals: [DualSVec64<N>; N] =
+            std::array::from_fn(|j| DualSVec64::from_re(self.at[j]).derivative(j));
+        let mut jacobian = DMatrix::zeros(self.points.len(), N);
         for (i, p) in self.points.iter().enumerate() {
-            let value = residual(&self.at.frame, self.radius, &duals, p);
-            let row = value.eps.unwrap_generic(Const::<PARAMS>, U1);
-            for j in 0..PARAMS {
+            let value = self.model.residual(&duals, p);
+            let row = value.eps.unwrap_generic(Const::<N>, U1);
+            for j in 0..N {
                 if !row[j].is_finite() {
                     return None;
                 }
