@@ -1,4 +1,5 @@
-//! Point files: CSV with a header, `y,z` for a planar profile or `x,y,z` for 3-D points, in millimetres.
+//! Point files: CSV with a header, `y,z` for a planar profile or `x,y,z` for 3-D points, in millimetres, and
+//! `x,y,z,segment` for 3-D points of a segmented part.
 //! Every problem is reported with the file and the line, so an operator can find it in an editor.
 
 use std::path::{Path, PathBuf};
@@ -50,6 +51,128 @@ const HEADER_HELP: &str = "expected a header of y,z (a profile) or x,y,z (3-D po
 
 /// Reads a point file.
 pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
+    let table = read_table(path)?;
+    if let Some(unknown) = table
+        .header
+        .iter()
+        .find(|c| !["x", "y", "z"].contains(&c.as_str()))
+    {
+        let hint = if unknown == SEGMENT_COLUMN {
+            "; a segment column is read by `zeroset fit supershape`"
+        } else {
+            ""
+        };
+        return Err(table.error(
+            Some(1),
+            format!("unknown column '{unknown}' ({HEADER_HELP}{hint})"),
+        ));
+    }
+    let spatial = match table.columns().as_slice() {
+        ["y", "z"] => false,
+        ["x", "y", "z"] => true,
+        _ => {
+            return Err(table.error(
+                Some(1),
+                format!("header '{}' ({HEADER_HELP})", table.header.join(",")),
+            ))
+        }
+    };
+    let rows = table
+        .rows
+        .iter()
+        .map(|(line, record)| table.coordinates(*line, record, table.header.len()))
+        .collect::<Result<Vec<Vec<f64>>, _>>()?;
+    Ok(if spatial {
+        PointSet::Spatial(
+            rows.iter()
+                .map(|r| Vector3::new(r[0], r[1], r[2]))
+                .collect(),
+        )
+    } else {
+        PointSet::Profile(rows.iter().map(|r| Vector2::new(r[0], r[1])).collect())
+    })
+}
+
+/// The column that names the segment of a part a point belongs to (seed 001 section 6.3: a segmented scan).
+pub const SEGMENT_COLUMN: &str = "segment";
+
+/// The 3-D points of one segment of a part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    /// The segment's name from the file; empty for a file without a segment column.
+    pub label: String,
+    pub points: Vec<Vector3<f64>>,
+}
+
+/// Reads 3-D points, `x,y,z` (one unnamed segment) or `x,y,z,segment` (the segments in the order they first
+/// appear, each with its points in file order).
+pub fn read_segments(path: &Path) -> Result<Vec<Segment>, PointFileError> {
+    let table = read_table(path)?;
+    match table.columns().as_slice() {
+        ["x", "y", "z"] | ["x", "y", "z", SEGMENT_COLUMN] => {}
+        _ => {
+            return Err(table.error(
+                Some(1),
+                format!(
+                    "header '{}' (expected x,y,z or x,y,z,{SEGMENT_COLUMN}: 3-D points in mm, with the segment \
+                     of the part each belongs to)",
+                    table.header.join(",")
+                ),
+            ))
+        }
+    }
+    let mut segments: Vec<Segment> = Vec::new();
+    for (line, record) in &table.rows {
+        let r = table.coordinates(*line, record, 3)?;
+        let label = record.get(3).unwrap_or_default();
+        if table.header.len() == 4 && label.is_empty() {
+            return Err(table.error(*line, format!("column {SEGMENT_COLUMN}: no segment named")));
+        }
+        let point = Vector3::new(r[0], r[1], r[2]);
+        match segments.iter_mut().find(|s| s.label == label) {
+            Some(segment) => segment.points.push(point),
+            None => segments.push(Segment {
+                label: label.to_string(),
+                points: vec![point],
+            }),
+        }
+    }
+    Ok(segments)
+}
+
+/// A point file's header and records, each record with its line and as many fields as the header.
+struct Table {
+    path: PathBuf,
+    header: Vec<String>,
+    rows: Vec<(Option<u64>, csv::StringRecord)>,
+}
+
+impl Table {
+    fn error(&self, line: Option<u64>, problem: impl Into<String>) -> PointFileError {
+        PointFileError::new(&self.path, line, problem)
+    }
+
+    fn columns(&self) -> Vec<&str> {
+        self.header.iter().map(String::as_str).collect()
+    }
+
+    /// The first `count` fields of a record as coordinates.
+    fn coordinates(
+        &self,
+        line: Option<u64>,
+        record: &csv::StringRecord,
+        count: usize,
+    ) -> Result<Vec<f64>, PointFileError> {
+        record
+            .iter()
+            .zip(&self.header)
+            .take(count)
+            .map(|(field, column)| parse_coordinate(field, column).map_err(|p| self.error(line, p)))
+            .collect()
+    }
+}
+
+fn read_table(path: &Path) -> Result<Table, PointFileError> {
     let file = std::fs::File::open(path)
         .map_err(|e| PointFileError::new(path, None, format!("cannot open: {e}")))?;
     let mut reader = csv::ReaderBuilder::new()
@@ -62,33 +185,7 @@ pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
         .iter()
         .map(str::to_string)
         .collect();
-    if let Some(unknown) = header
-        .iter()
-        .find(|c| !["x", "y", "z"].contains(&c.as_str()))
-    {
-        return Err(PointFileError::new(
-            path,
-            Some(1),
-            format!("unknown column '{unknown}' ({HEADER_HELP})"),
-        ));
-    }
-    let spatial = match header
-        .iter()
-        .map(String::as_str)
-        .collect::<Vec<_>>()
-        .as_slice()
-    {
-        ["y", "z"] => false,
-        ["x", "y", "z"] => true,
-        _ => {
-            return Err(PointFileError::new(
-                path,
-                Some(1),
-                format!("header '{}' ({HEADER_HELP})", header.join(",")),
-            ))
-        }
-    };
-    let mut rows: Vec<Vec<f64>> = Vec::new();
+    let mut rows = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| {
             let line = e.position().map(|p| p.line());
@@ -102,14 +199,7 @@ pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
                 format!("{} fields, the header has {}", record.len(), header.len()),
             ));
         }
-        let values = record
-            .iter()
-            .zip(&header)
-            .map(|(field, column)| {
-                parse_coordinate(field, column).map_err(|p| PointFileError::new(path, line, p))
-            })
-            .collect::<Result<Vec<f64>, _>>()?;
-        rows.push(values);
+        rows.push((line, record));
     }
     if rows.is_empty() {
         return Err(PointFileError::new(
@@ -118,14 +208,10 @@ pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
             "no points after the header",
         ));
     }
-    Ok(if spatial {
-        PointSet::Spatial(
-            rows.iter()
-                .map(|r| Vector3::new(r[0], r[1], r[2]))
-                .collect(),
-        )
-    } else {
-        PointSet::Profile(rows.iter().map(|r| Vector2::new(r[0], r[1])).collect())
+    Ok(Table {
+        path: path.to_path_buf(),
+        header,
+        rows,
     })
 }
 
@@ -189,6 +275,9 @@ mod tests {
         assert!(read("y,z\n1,2\n1,2,3\n")
             .unwrap_err()
             .starts_with("DIR/points.csv: line 3:"));
+        assert!(read("x,y,z,segment\n1,2,3,a\n")
+            .unwrap_err()
+            .ends_with("a segment column is read by `zeroset fit supershape`)"));
         let missing = read_points(Path::new("/no/such/points.csv"))
             .unwrap_err()
             .to_string();
@@ -196,5 +285,49 @@ mod tests {
             missing.starts_with("/no/such/points.csv: cannot open"),
             "{missing}"
         );
+    }
+
+    fn segments(text: &str) -> Result<Vec<Segment>, String> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("points.csv");
+        std::fs::write(&path, text).unwrap();
+        read_segments(&path).map_err(|e| {
+            e.to_string()
+                .replace(&dir.path().display().to_string(), "DIR")
+        })
+    }
+
+    /// Segments come in the order they first appear, each with its points in file order; a file without the
+    /// column is one unnamed segment.
+    #[test]
+    fn reads_segments_in_order() {
+        let read = segments("x,y,z,segment\n1,2,3,body\n4,5,6,boss\n7,8,9,body\n").unwrap();
+        assert_eq!(
+            read,
+            vec![
+                Segment {
+                    label: "body".into(),
+                    points: vec![Vector3::new(1.0, 2.0, 3.0), Vector3::new(7.0, 8.0, 9.0)]
+                },
+                Segment {
+                    label: "boss".into(),
+                    points: vec![Vector3::new(4.0, 5.0, 6.0)]
+                },
+            ]
+        );
+        let one = segments("x,y,z\n1,2,3\n").unwrap();
+        assert_eq!(one.len(), 1);
+        assert_eq!(one[0].label, "");
+        assert_eq!(
+            segments("x,y,z,segment\n1,2,3,\n").unwrap_err(),
+            "DIR/points.csv: line 2: column segment: no segment named"
+        );
+        assert_eq!(
+            segments("x,y,z,segment\n1,2,q,a\n").unwrap_err(),
+            "DIR/points.csv: line 2: column z: 'q' is not a number"
+        );
+        assert!(segments("y,z\n1,2\n")
+            .unwrap_err()
+            .contains("line 1: header 'y,z' (expected x,y,z or x,y,z,segment"));
     }
 }

@@ -1,21 +1,25 @@
 //! `zeroset fit supershape`: recover a supershape model from measured x,y,z points (seed 001) and save it as a
-//! model file, with the exact distances of the points to it.
+//! model file, with the exact distances of the points to it; a part scanned in segments (`x,y,z,segment`) is
+//! recovered segment by segment and joined by union (seed 001 section 6.3).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::bail;
 use clap::Args;
 use nalgebra::Point3;
 
+use crate::geometry::supershape::csg::Solid;
 use crate::geometry::supershape::distance::SolidDistance;
-use crate::geometry::supershape::recover::{recover, Family, RecoveryOptions};
+use crate::geometry::supershape::recover::{
+    recover, recover_segments, Family, Recovered, RecoveryOptions, SegmentPoints,
+};
 use crate::model_file::{ModelFile, ReferenceModel, SolidFitStats};
-use crate::points::{read_points, PointSet};
+use crate::points::read_segments;
 
 #[derive(Args)]
 pub struct FitSupershapeArgs {
-    /// Point file: CSV with header x,y,z, in mm, spread over the part's surface.
+    /// Point file: CSV with header x,y,z, in mm, spread over the part's surface; or x,y,z,segment for a part
+    /// scanned in segments, each recovered on its own and all joined by union.
     #[arg(long)]
     points: PathBuf,
     /// The symmetry numbers of the two superformulas when known, "m1,m2" (a superquadric is 4,4; a hex prism
@@ -53,13 +57,13 @@ fn parse_symmetry(text: &str) -> Result<[u32; 2], String> {
 
 pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let points: Vec<Point3<f64>> = match read_points(&args.points)? {
-        PointSet::Spatial(points) => points.into_iter().map(Point3::from).collect(),
-        PointSet::Profile(_) => bail!(
-            "{}: a supershape is recovered from x,y,z points over the part's surface; this file has y,z",
-            args.points.display()
-        ),
-    };
+    let segments: Vec<SegmentPoints> = read_segments(&args.points)?
+        .into_iter()
+        .map(|s| SegmentPoints {
+            label: s.label,
+            points: s.points.into_iter().map(Point3::from).collect(),
+        })
+        .collect();
     let family = if args.superquadric {
         Family::Superquadric
     } else {
@@ -71,20 +75,120 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         truncate: !args.no_truncation,
         holes: !args.no_holes,
     };
+    let what = if args.superquadric {
+        "superquadric"
+    } else {
+        "supershape"
+    };
+    let (solid, method) = match &segments[..] {
+        [one] if one.label.is_empty() => whole(args, &one.points, &options, what)?,
+        _ => segmented(args, &segments, &options, what)?,
+    };
+    let points: Vec<Point3<f64>> = segments.iter().flat_map(|s| s.points.clone()).collect();
+    let stats = SolidFitStats::of(&SolidDistance::new(&solid), &points);
+    let file = ModelFile::new(method, ReferenceModel::Supershape { solid, fit: stats });
+    file.save(&args.out)?;
+    match stats {
+        Some(s) => println!(
+            "  exact distances of the points: RMS {:.4} mm, max {:.4} mm",
+            s.rms_distance_mm, s.max_distance_mm
+        ),
+        None => println!("  some points have no exact distance to the model"),
+    }
+    println!(
+        "wrote {} ({:.2} s)",
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// One part's points recovered as one envelope (with its holes): the solid and how it was found.
+fn whole(
+    args: &FitSupershapeArgs,
+    points: &[Point3<f64>],
+    options: &RecoveryOptions,
+    what: &str,
+) -> anyhow::Result<(Solid, String)> {
     // A recovery tries dozens of starts and takes seconds: say so before the wait.
     eprintln!(
-        "recovering a {} from {} points of {} (a few seconds)...",
-        if args.superquadric {
-            "superquadric"
-        } else {
-            "supershape"
-        },
+        "recovering a {what} from {} points of {} (a few seconds)...",
         points.len(),
         args.points.display()
     );
-    let recovered = recover(&points, &options)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
-    let stats = SolidFitStats::of(&SolidDistance::new(&recovered.solid), &points);
+    let recovered =
+        recover(points, options).map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
+    let (primitives, booleans) = recovered.solid.root().counts();
+    println!(
+        "{what} of {}: {} points, {primitives} primitives and {booleans} Booleans, symmetry {},{}, global error \
+         (eq. 15) {:.4e} mm^3",
+        args.points.display(),
+        points.len(),
+        recovered.symmetry[0],
+        recovered.symmetry[1],
+        recovered.global_error
+    );
+    describe(args, &recovered);
+    let method = format!(
+        "{what} recovery (seed 001): {}",
+        how_found(args, &recovered)
+    );
+    Ok((recovered.solid, method))
+}
+
+/// A segmented part's points (`x,y,z,segment`) recovered segment by segment and joined by R_p union.
+fn segmented(
+    args: &FitSupershapeArgs,
+    segments: &[SegmentPoints],
+    options: &RecoveryOptions,
+    what: &str,
+) -> anyhow::Result<(Solid, String)> {
+    let object = recover_segments(segments, options, &mut |k, segment| {
+        eprintln!(
+            "recovering segment '{}' ({} of {}) as a {what} from {} points (a few seconds)...",
+            segment.label,
+            k + 1,
+            segments.len(),
+            segment.points.len()
+        )
+    })
+    .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
+    let (primitives, booleans) = object.solid.root().counts();
+    println!(
+        "{} segments of {} joined by R_p union: {} points, {primitives} primitives and {booleans} Booleans, \
+         global error (eq. 15) {:.4e} mm^3",
+        object.segments.len(),
+        args.points.display(),
+        segments.iter().map(|s| s.points.len()).sum::<usize>(),
+        object.global_error
+    );
+    let mut found = Vec::new();
+    for (segment, points) in object.segments.iter().zip(segments) {
+        println!(
+            "  segment '{}': {} points, symmetry {},{}, global error {:.4e} mm^3",
+            segment.label,
+            points.points.len(),
+            segment.recovered.symmetry[0],
+            segment.recovered.symmetry[1],
+            segment.recovered.global_error
+        );
+        describe(args, &segment.recovered);
+        found.push(format!(
+            "segment '{}': {}",
+            segment.label,
+            how_found(args, &segment.recovered)
+        ));
+    }
+    let method = format!(
+        "{what} recovery (seed 001) of {} segments joined by R_p union; {}",
+        object.segments.len(),
+        found.join("; ")
+    );
+    Ok((object.solid, method))
+}
+
+/// The search behind one recovery, for the model file.
+fn how_found(args: &FitSupershapeArgs, recovered: &Recovered) -> String {
     let how = |k: usize| {
         if args.symmetry.is_some() || args.superquadric {
             "given"
@@ -94,34 +198,18 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
             "4: nothing stood out"
         }
     };
-    let method = format!(
-        "{} recovery (seed 001): Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), \
-         m2 = {} ({})",
-        if args.superquadric { "superquadric" } else { "supershape" },
+    format!(
+        "Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), m2 = {} ({})",
         recovered.starts,
         recovered.symmetry[0],
         how(0),
         recovered.symmetry[1],
         how(1)
-    );
-    let file = ModelFile::new(
-        method,
-        ReferenceModel::Supershape {
-            solid: recovered.solid.clone(),
-            fit: stats,
-        },
-    );
-    file.save(&args.out)?;
-    let (primitives, booleans) = recovered.solid.root().counts();
-    println!(
-        "supershape of {}: {} points, {primitives} primitives and {booleans} Booleans, symmetry {},{}, global error \
-         (eq. 15) {:.4e} mm^3",
-        args.points.display(),
-        points.len(),
-        recovered.symmetry[0],
-        recovered.symmetry[1],
-        recovered.global_error
-    );
+    )
+}
+
+/// One recovery's envelope, superquadric and holes, as printed lines.
+fn describe(args: &FitSupershapeArgs, recovered: &Recovered) {
     if args.superquadric {
         let (shape, _) = &recovered.envelope;
         println!(
@@ -139,17 +227,4 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
         recovered.rms_radial_mm,
         recovered.holes.len()
     );
-    match stats {
-        Some(s) => println!(
-            "  exact distances of the points: RMS {:.4} mm, max {:.4} mm",
-            s.rms_distance_mm, s.max_distance_mm
-        ),
-        None => println!("  some points have no exact distance to the model"),
-    }
-    println!(
-        "wrote {} ({:.2} s)",
-        args.out.display(),
-        started.elapsed().as_secs_f64()
-    );
-    Ok(())
 }

@@ -356,3 +356,97 @@ fn a_superquadric_is_recovered_with_its_sizes_and_exponents() {
         refused.stderr
     );
 }
+
+/// Points on the ellipsoid of `centre` and semi-axes `axes` that lie outside the other ellipsoid, labelled.
+fn ellipsoid_segment(
+    label: &str,
+    count: usize,
+    centre: [f64; 3],
+    axes: [f64; 3],
+    other: ([f64; 3], [f64; 3]),
+) -> String {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut text = String::new();
+    for i in 0..count {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+        let r = (1.0 - z * z).sqrt();
+        let phi = golden * i as f64;
+        let unit = [r * phi.cos(), r * phi.sin(), z];
+        let p: Vec<f64> = (0..3).map(|k| centre[k] + axes[k] * unit[k]).collect();
+        let (c, a) = other;
+        let inside: f64 = (0..3).map(|k| ((p[k] - c[k]) / a[k]).powi(2)).sum();
+        if inside > 1.0 {
+            text.push_str(&format!("{:.6},{:.6},{:.6},{label}\n", p[0], p[1], p[2]));
+        }
+    }
+    text
+}
+
+/// A part scanned in two segments (`x,y,z,segment`: a body and a cap standing out of its top) is recovered
+/// segment by segment and joined by union: the model holds every point of both within 0.05 mm, and a segment
+/// too small to fit is named in the error.
+#[test]
+fn a_segmented_scan_is_recovered_as_the_union_of_its_segments() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = ([0.0, 0.0, 0.0], [40.0, 30.0, 20.0]);
+    let cap = ([5.0, 0.0, 22.0], [15.0, 12.0, 10.0]);
+    let points = dir.path().join("segments.csv");
+    std::fs::write(
+        &points,
+        format!(
+            "x,y,z,segment\n{}{}",
+            ellipsoid_segment("body", 2000, body.0, body.1, cap),
+            ellipsoid_segment("cap", 1200, cap.0, cap.1, body)
+        ),
+    )
+    .unwrap();
+    let model = dir.path().join("segments.json");
+    let printed = crate::support::zeroset_ok(&[
+        "fit",
+        "supershape",
+        "--points",
+        points.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        printed.contains("2 segments of")
+            && printed.contains("segment 'body'")
+            && printed.contains("segment 'cap'"),
+        "{printed}"
+    );
+    let rms: f64 = printed
+        .split("exact distances of the points: RMS ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{printed}"));
+    assert!(rms < 0.05, "RMS {rms} mm: {printed}");
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    assert!(saved["method"]
+        .as_str()
+        .unwrap()
+        .contains("2 segments joined by R_p union"));
+    std::fs::write(
+        &points,
+        format!(
+            "x,y,z,segment\n{}1,2,3,burr\n",
+            ellipsoid_segment("body", 500, body.0, body.1, cap)
+        ),
+    )
+    .unwrap();
+    let refused = crate::support::zeroset(&[
+        "fit",
+        "supershape",
+        "--points",
+        points.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert!(
+        !refused.success && refused.stderr.contains("segment 'burr': 1 points cannot fix"),
+        "{}",
+        refused.stderr
+    );
+}

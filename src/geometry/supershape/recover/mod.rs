@@ -11,6 +11,7 @@
 mod holes;
 mod model;
 mod problem;
+mod segments;
 mod similarity;
 mod starts;
 mod superquadric;
@@ -29,6 +30,9 @@ use super::deform::{Deformation, Deformations};
 use super::rfunc::{Boolean, RFunction};
 use super::shape::Supershape;
 
+pub use self::segments::{
+    recover_segments, RecoveredObject, RecoveredSegment, SegmentError, SegmentPoints,
+};
 pub use self::similarity::{
     fit_pose, global_error, surface_distance_bound, surface_gap_rms, Pose, PoseFit,
 };
