@@ -445,7 +445,10 @@ fn a_segmented_scan_is_recovered_as_the_union_of_its_segments() {
         model.to_str().unwrap(),
     ]);
     assert!(
-        !refused.success && refused.stderr.contains("segment 'burr': 1 points cannot fix"),
+        !refused.success
+            && refused
+                .stderr
+                .contains("segment 'burr': 1 points cannot fix"),
         "{}",
         refused.stderr
     );

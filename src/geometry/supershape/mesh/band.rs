@@ -9,6 +9,7 @@ use std::collections::HashSet;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::super::csg::{Aabb, NodeKind};
 use super::leaves::{Leaf, Leaves};
@@ -66,59 +67,16 @@ const MAX_DEPTH: u32 = 14;
 /// Every cell within one cell of a parametric sample of a primitive's surface, sorted. Patches
 /// are split until their corners are closer than half a cell, so every surface point lies within
 /// half a cell of a sample, and every cell the surface crosses is a neighbour of a sampled cell.
+/// The primitives are sampled on every core, each into its own set.
 pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
-    let mut sampled = HashSet::new();
-    for leaf in &leaves.leaves {
-        let clip = leaf.clip;
-        let mut mark = |p: Point3<f64>| {
-            if clip.contains(&p) {
-                if let Some(c) = grid.cell_of(&p) {
-                    sampled.insert(c);
-                }
-            }
-        };
-        match &leaf.node().kind {
-            NodeKind::Supershape { shape } => {
-                let surface = |theta: f64, phi: f64| leaf.to_model(&shape.point(theta, phi));
-                let (nt, np) = BASE_SUPERSHAPE;
-                let (dt, dp) = (2.0 * PI / nt as f64, PI / np as f64);
-                for i in 0..nt {
-                    for j in 0..np {
-                        let (t0, p0) = (-PI + i as f64 * dt, -FRAC_PI_2 + j as f64 * dp);
-                        sample_patch(
-                            &surface,
-                            [t0, t0 + dt, p0, p0 + dp],
-                            grid.cell,
-                            0,
-                            &mut mark,
-                        );
-                    }
-                }
-            }
-            NodeKind::Cuboid { half_extents } => {
-                for axis in 0..3 {
-                    for side in [-1.0, 1.0] {
-                        let surface =
-                            |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
-                        let d = 2.0 / BASE_FACE as f64;
-                        for i in 0..BASE_FACE {
-                            for j in 0..BASE_FACE {
-                                let (u0, v0) = (-1.0 + i as f64 * d, -1.0 + j as f64 * d);
-                                sample_patch(
-                                    &surface,
-                                    [u0, u0 + d, v0, v0 + d],
-                                    grid.cell,
-                                    0,
-                                    &mut mark,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-            NodeKind::Boolean { .. } => unreachable!("leaves are primitives"),
-        }
-    }
+    let sampled: HashSet<[u64; 3]> = leaves
+        .leaves
+        .par_iter()
+        .map(|leaf| sampled_cells(leaf, grid))
+        .reduce(HashSet::new, |mut all, more| {
+            all.extend(more);
+            all
+        });
     let mut band = HashSet::with_capacity(sampled.len() * 4);
     for c in &sampled {
         for dz in -1..=1 {
@@ -137,6 +95,48 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
     cells
 }
 
+/// The cells holding a parametric sample of one primitive's surface within its clip box.
+fn sampled_cells(leaf: &Leaf, grid: &Grid) -> HashSet<[u64; 3]> {
+    let mut sampled = HashSet::new();
+    let clip = leaf.clip;
+    let mut mark = |p: &Point3<f64>| {
+        if clip.contains(p) {
+            if let Some(c) = grid.cell_of(p) {
+                sampled.insert(c);
+            }
+        }
+    };
+    match &leaf.node().kind {
+        NodeKind::Supershape { shape } => {
+            let surface = |theta: f64, phi: f64| leaf.to_model(&shape.point(theta, phi));
+            let (nt, np) = BASE_SUPERSHAPE;
+            let (dt, dp) = (2.0 * PI / nt as f64, PI / np as f64);
+            for i in 0..nt {
+                for j in 0..np {
+                    let (t0, p0) = (-PI + i as f64 * dt, -FRAC_PI_2 + j as f64 * dp);
+                    sample_patch(&surface, [t0, t0 + dt, p0, p0 + dp], grid.cell, &mut mark);
+                }
+            }
+        }
+        NodeKind::Cuboid { half_extents } => {
+            for axis in 0..3 {
+                for side in [-1.0, 1.0] {
+                    let surface = |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
+                    let d = 2.0 / BASE_FACE as f64;
+                    for i in 0..BASE_FACE {
+                        for j in 0..BASE_FACE {
+                            let (u0, v0) = (-1.0 + i as f64 * d, -1.0 + j as f64 * d);
+                            sample_patch(&surface, [u0, u0 + d, v0, v0 + d], grid.cell, &mut mark);
+                        }
+                    }
+                }
+            }
+        }
+        NodeKind::Boolean { .. } => unreachable!("leaves are primitives"),
+    }
+    sampled
+}
+
 /// A point of face `axis`/`side` of a box at face coordinates (u, v) in [-1, 1], in the model frame.
 fn face_point(leaf: &Leaf, half: &[f64; 3], axis: usize, side: f64, u: f64, v: f64) -> Point3<f64> {
     let mut c = [0.0; 3];
@@ -152,8 +152,7 @@ fn sample_patch(
     surface: &impl Fn(f64, f64) -> Point3<f64>,
     [u0, u1, v0, v1]: [f64; 4],
     cell: f64,
-    depth: u32,
-    mark: &mut impl FnMut(Point3<f64>),
+    mark: &mut impl FnMut(&Point3<f64>),
 ) {
     let corners = [
         surface(u0, v0),
@@ -161,22 +160,42 @@ fn sample_patch(
         surface(u1, v1),
         surface(u0, v1),
     ];
+    split_patch(surface, [u0, u1, v0, v1], &corners, cell, 0, mark);
+}
+
+/// One patch with its corners (in the order (u0, v0), (u1, v0), (u1, v1), (u0, v1)) already on the
+/// surface: marked, or split in four at its middle lines, the corners shared with the children so
+/// that each split costs five new surface points, not sixteen.
+fn split_patch(
+    surface: &impl Fn(f64, f64) -> Point3<f64>,
+    [u0, u1, v0, v1]: [f64; 4],
+    corners: &[Point3<f64>; 4],
+    cell: f64,
+    depth: u32,
+    mark: &mut impl FnMut(&Point3<f64>),
+) {
     let spread = (corners[0] - corners[2])
         .norm()
         .max((corners[1] - corners[3]).norm());
     if spread <= 0.5 * cell || depth == MAX_DEPTH {
-        for c in corners {
-            mark(c);
-        }
+        corners.iter().for_each(&mut *mark);
         return;
     }
     let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
-    for rect in [
-        [u0, um, v0, vm],
-        [um, u1, v0, vm],
-        [um, u1, vm, v1],
-        [u0, um, vm, v1],
+    let [c00, c10, c11, c01] = *corners;
+    let (bottom, right, top, left, middle) = (
+        surface(um, v0),
+        surface(u1, vm),
+        surface(um, v1),
+        surface(u0, vm),
+        surface(um, vm),
+    );
+    for (rect, corners) in [
+        ([u0, um, v0, vm], [c00, bottom, middle, left]),
+        ([um, u1, v0, vm], [bottom, c10, right, middle]),
+        ([um, u1, vm, v1], [middle, right, c11, top]),
+        ([u0, um, vm, v1], [left, middle, top, c01]),
     ] {
-        sample_patch(surface, rect, cell, depth + 1, mark);
+        split_patch(surface, rect, &corners, cell, depth + 1, mark);
     }
 }

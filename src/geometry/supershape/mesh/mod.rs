@@ -34,6 +34,7 @@ mod tetra;
 mod trimesh;
 
 use nalgebra::Point3;
+use rayon::prelude::*;
 
 use super::csg::Solid;
 
@@ -109,15 +110,14 @@ pub fn polygonise(solid: &Solid, params: &MeshParams) -> Result<TriMesh, MeshErr
     let cells = band::band(&leaves, &grid);
     let mut surface = tetra::march(&leaves, &grid, &cells, epsilon)?;
     crease::sharpen(&leaves, solid, &mut surface, epsilon, delta);
-    for v in &surface.vertices {
-        let value = solid.value(v);
-        if value.is_nan() || value.abs() >= epsilon {
-            return Err(MeshError::OffSurface {
-                at: *v,
-                value,
-                epsilon,
-            });
-        }
+    // Every vertex on the whole tree, on every core; the first one off the surface is reported.
+    let off_surface = surface
+        .vertices
+        .par_iter()
+        .map(|v| (*v, solid.value(v)))
+        .find_first(|(_, value)| value.is_nan() || value.abs() >= epsilon);
+    if let Some((at, value)) = off_surface {
+        return Err(MeshError::OffSurface { at, value, epsilon });
     }
     Ok(TriMesh {
         vertices: surface.vertices,

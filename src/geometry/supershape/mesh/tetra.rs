@@ -12,6 +12,7 @@
 use std::collections::HashMap;
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::band::Grid;
 use super::leaves::Leaves;
@@ -40,28 +41,36 @@ const TETRAHEDRA: [[usize; 4]; 6] = [
     [0, 4, 6, 7],
 ];
 
+/// The surface in the band's cells. The corners' signs and the edges' roots, the costly part,
+/// are found on every core; which edges cross and how their vertices join is decided in one pass
+/// over the cells in order, so the mesh is the same whatever the number of cores.
 pub(super) fn march(
     leaves: &Leaves,
     grid: &Grid,
     cells: &[[u64; 3]],
     epsilon: f64,
 ) -> Result<Surface, MeshError> {
-    let mut signs: HashMap<u64, bool> = HashMap::new();
-    let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
-    let mut surface = Surface {
-        vertices: Vec::new(),
-        on: Vec::new(),
-        triangles: Vec::new(),
+    let corners_of = |cell: &[u64; 3]| -> [[u64; 3]; 8] {
+        std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]))
     };
+    let mut grid_vertices: Vec<(u64, [u64; 3])> = cells
+        .iter()
+        .flat_map(|cell| corners_of(cell).map(|ijk| (grid.vertex_id(ijk), ijk)))
+        .collect();
+    grid_vertices.sort_unstable_by_key(|(id, _)| *id);
+    grid_vertices.dedup_by_key(|(id, _)| *id);
+    let signs: HashMap<u64, bool> = grid_vertices
+        .par_iter()
+        .map(|(id, ijk)| (*id, leaves.inside(&grid.vertex_point(*ijk))))
+        .collect();
+    let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
+    // The grid edges whose roots are wanted, (inside end, outside end), in vertex order.
+    let mut crossings: Vec<(Point3<f64>, Point3<f64>)> = Vec::new();
+    let mut loops: Vec<Vec<u32>> = Vec::new();
     for cell in cells {
-        let corners: [[u64; 3]; 8] =
-            std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]));
+        let corners = corners_of(cell);
         let ids = corners.map(|ijk| grid.vertex_id(ijk));
-        let inside: [bool; 8] = std::array::from_fn(|c| {
-            *signs
-                .entry(ids[c])
-                .or_insert_with(|| leaves.inside(&grid.vertex_point(corners[c])))
-        });
+        let inside: [bool; 8] = std::array::from_fn(|c| signs[&ids[c]]);
         if inside.iter().all(|&s| s == inside[0]) {
             continue;
         }
@@ -89,32 +98,34 @@ pub(super) fn march(
             let outward = outs.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / outs.len() as f64
                 - ins.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / ins.len() as f64;
             let normal = (mid(edges[1]) - mid(edges[0])).cross(&(mid(edges[2]) - mid(edges[0])));
-            let mut loop_ids = Vec::with_capacity(4);
-            for &(i, o) in &edges {
-                let key = (ids[i].min(ids[o]), ids[i].max(ids[o]));
-                let vertex = match roots.get(&key) {
-                    Some(&v) => v,
-                    None => {
-                        let (point, leaf) = edge_root(
-                            leaves,
-                            grid.vertex_point(corners[i]),
-                            grid.vertex_point(corners[o]),
-                            epsilon,
-                        )?;
-                        surface.vertices.push(point);
-                        surface.on.push((leaf, leaf));
-                        let v = (surface.vertices.len() - 1) as u32;
-                        roots.insert(key, v);
-                        v
-                    }
-                };
-                loop_ids.push(vertex);
-            }
+            let mut loop_ids: Vec<u32> = edges
+                .iter()
+                .map(|&(i, o)| {
+                    let key = (ids[i].min(ids[o]), ids[i].max(ids[o]));
+                    *roots.entry(key).or_insert_with(|| {
+                        crossings
+                            .push((grid.vertex_point(corners[i]), grid.vertex_point(corners[o])));
+                        (crossings.len() - 1) as u32
+                    })
+                })
+                .collect();
             if normal.dot(&outward) < 0.0 {
                 loop_ids.reverse();
             }
-            push_polygon(&mut surface, &loop_ids);
+            loops.push(loop_ids);
         }
+    }
+    let solved: Vec<(Point3<f64>, usize)> = crossings
+        .par_iter()
+        .map(|(inside, outside)| edge_root(leaves, *inside, *outside, epsilon))
+        .collect::<Result<_, _>>()?;
+    let mut surface = Surface {
+        vertices: solved.iter().map(|(point, _)| *point).collect(),
+        on: solved.iter().map(|(_, leaf)| (*leaf, *leaf)).collect(),
+        triangles: Vec::new(),
+    };
+    for loop_ids in &loops {
+        push_polygon(&mut surface, loop_ids);
     }
     Ok(surface)
 }
