@@ -119,7 +119,10 @@ fn bench_recovery(c: &mut Criterion) {
             (shape, points)
         })
         .collect();
-    for (name, options) in [("superquadric", &superquadric), ("supershape_4_4", &given)] {
+    for (name, options) in [
+        ("superquadric_family", &superquadric),
+        ("supershape_4_4", &given),
+    ] {
         for (shape, points) in &scans {
             let recovered = recover(points, options).expect("a superquadric recovers");
             eprintln!(

@@ -51,32 +51,21 @@ const HEADER_HELP: &str = "expected a header of y,z (a profile) or x,y,z (3-D po
 
 /// Reads a point file.
 pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
-    let table = read_table(path)?;
-    if let Some(unknown) = table
-        .header
-        .iter()
-        .find(|c| !["x", "y", "z"].contains(&c.as_str()))
-    {
-        let hint = if unknown == SEGMENT_COLUMN {
-            "; a segment column is read by `zeroset fit supershape`"
-        } else {
-            ""
-        };
-        return Err(table.error(
-            Some(1),
-            format!("unknown column '{unknown}' ({HEADER_HELP}{hint})"),
-        ));
-    }
-    let spatial = match table.columns().as_slice() {
-        ["y", "z"] => false,
-        ["x", "y", "z"] => true,
-        _ => {
-            return Err(table.error(
-                Some(1),
-                format!("header '{}' ({HEADER_HELP})", table.header.join(",")),
-            ))
+    let table = read_table(path, |header| {
+        if let Some(unknown) = header.iter().find(|c| !["x", "y", "z"].contains(c)) {
+            let hint = if *unknown == SEGMENT_COLUMN {
+                "; a segment column is read by `zeroset fit supershape`"
+            } else {
+                ""
+            };
+            return Err(format!("unknown column '{unknown}' ({HEADER_HELP}{hint})"));
         }
-    };
+        match header {
+            ["y", "z"] | ["x", "y", "z"] => Ok(()),
+            _ => Err(format!("header '{}' ({HEADER_HELP})", header.join(","))),
+        }
+    })?;
+    let spatial = table.header.len() == 3;
     let rows = table
         .rows
         .iter()
@@ -107,20 +96,21 @@ pub struct Segment {
 /// Reads 3-D points, `x,y,z` (one unnamed segment) or `x,y,z,segment` (the segments in the order they first
 /// appear, each with its points in file order).
 pub fn read_segments(path: &Path) -> Result<Vec<Segment>, PointFileError> {
-    let table = read_table(path)?;
-    match table.columns().as_slice() {
-        ["x", "y", "z"] | ["x", "y", "z", SEGMENT_COLUMN] => {}
+    let table = read_table(path, |header| match header {
+        ["x", "y", "z"] | ["x", "y", "z", SEGMENT_COLUMN] => Ok(()),
         _ => {
-            return Err(table.error(
-                Some(1),
-                format!(
-                    "header '{}' (expected x,y,z or x,y,z,{SEGMENT_COLUMN}: 3-D points in mm, with the segment \
-                     of the part each belongs to)",
-                    table.header.join(",")
-                ),
+            let hint = if header == ["y", "z"] {
+                "; y,z is a planar profile, and this needs points over a part's surface"
+            } else {
+                ""
+            };
+            Err(format!(
+                "header '{}' (expected x,y,z or x,y,z,{SEGMENT_COLUMN}: 3-D points in mm, with the segment of the \
+                 part each belongs to{hint})",
+                header.join(",")
             ))
         }
-    }
+    })?;
     let mut segments: Vec<Segment> = Vec::new();
     for (line, record) in &table.rows {
         let r = table.coordinates(*line, record, 3)?;
@@ -152,10 +142,6 @@ impl Table {
         PointFileError::new(&self.path, line, problem)
     }
 
-    fn columns(&self) -> Vec<&str> {
-        self.header.iter().map(String::as_str).collect()
-    }
-
     /// The first `count` fields of a record as coordinates.
     fn coordinates(
         &self,
@@ -172,7 +158,12 @@ impl Table {
     }
 }
 
-fn read_table(path: &Path) -> Result<Table, PointFileError> {
+/// Reads a point file whose header `check_header` accepts (or says why not, as the problem of line 1) before
+/// any record is read.
+fn read_table(
+    path: &Path,
+    check_header: impl FnOnce(&[&str]) -> Result<(), String>,
+) -> Result<Table, PointFileError> {
     let file = std::fs::File::open(path)
         .map_err(|e| PointFileError::new(path, None, format!("cannot open: {e}")))?;
     let mut reader = csv::ReaderBuilder::new()
@@ -185,6 +176,8 @@ fn read_table(path: &Path) -> Result<Table, PointFileError> {
         .iter()
         .map(str::to_string)
         .collect();
+    let columns: Vec<&str> = header.iter().map(String::as_str).collect();
+    check_header(&columns).map_err(|problem| PointFileError::new(path, Some(1), problem))?;
     let mut rows = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| {
@@ -275,6 +268,12 @@ mod tests {
         assert!(read("y,z\n1,2\n1,2,3\n")
             .unwrap_err()
             .starts_with("DIR/points.csv: line 3:"));
+        assert!(
+            read("y,w\n")
+                .unwrap_err()
+                .contains("line 1: unknown column 'w'"),
+            "a bad header is told before the missing points"
+        );
         assert!(read("x,y,z,segment\n1,2,3,a\n")
             .unwrap_err()
             .ends_with("a segment column is read by `zeroset fit supershape`)"));
@@ -329,5 +328,8 @@ mod tests {
         assert!(segments("y,z\n1,2\n")
             .unwrap_err()
             .contains("line 1: header 'y,z' (expected x,y,z or x,y,z,segment"));
+        assert!(segments("y,z\n1,2\n")
+            .unwrap_err()
+            .ends_with("y,z is a planar profile, and this needs points over a part's surface)"));
     }
 }

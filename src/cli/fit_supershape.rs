@@ -24,7 +24,7 @@ pub struct FitSupershapeArgs {
     points: PathBuf,
     /// The symmetry numbers of the two superformulas when known, "m1,m2" (a superquadric is 4,4; a hex prism
     /// 6,4); found from the points otherwise.
-    #[arg(long, value_parser = parse_symmetry, conflicts_with = "superquadric")]
+    #[arg(long, value_parser = parse_symmetry)]
     symmetry: Option<[u32; 2]>,
     /// Fit a superquadric (m1 = m2 = 4, each superformula's exponents equal: 11 parameters, epsilon1 along the
     /// axis, epsilon2 across it) instead of a general supershape.
@@ -69,16 +69,12 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
     } else {
         Family::Supershape
     };
+    let what = family.name();
     let options = RecoveryOptions {
         family,
         symmetry: args.symmetry,
         truncate: !args.no_truncation,
         holes: !args.no_holes,
-    };
-    let what = if args.superquadric {
-        "superquadric"
-    } else {
-        "supershape"
     };
     let (solid, method) = match &segments[..] {
         [one] if one.label.is_empty() => whole(args, &one.points, &options, what)?,

@@ -43,7 +43,7 @@ const TETRAHEDRA: [[usize; 4]; 6] = [
 
 /// The surface in the band's cells. The corners' signs and the edges' roots, the costly part,
 /// are found on every core; which edges cross and how their vertices join is decided in one pass
-/// over the cells in order, so the mesh is the same whatever the number of cores.
+/// over the cells in order, so the mesh (or the error) is the same whatever the number of cores.
 pub(super) fn march(
     leaves: &Leaves,
     grid: &Grid,
@@ -115,10 +115,12 @@ pub(super) fn march(
             loops.push(loop_ids);
         }
     }
-    let solved: Vec<(Point3<f64>, usize)> = crossings
+    // Solved on every core, then taken in order, so that a failure reported is the first edge's.
+    let solved: Vec<Result<(Point3<f64>, usize), MeshError>> = crossings
         .par_iter()
         .map(|(inside, outside)| edge_root(leaves, *inside, *outside, epsilon))
-        .collect::<Result<_, _>>()?;
+        .collect();
+    let solved: Vec<(Point3<f64>, usize)> = solved.into_iter().collect::<Result<_, _>>()?;
     let mut surface = Surface {
         vertices: solved.iter().map(|(point, _)| *point).collect(),
         on: solved.iter().map(|(_, leaf)| (*leaf, *leaf)).collect(),

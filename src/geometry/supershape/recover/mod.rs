@@ -20,7 +20,7 @@ mod symmetry;
 #[cfg(test)]
 mod tests;
 
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
 use self::model::{Candidate, Radius};
@@ -61,6 +61,16 @@ pub enum Family {
     /// Superquadrics (11 parameters): supershapes with m1 = m2 = 4 and each superformula's exponents equal,
     /// n = 2 / epsilon; the family of superquadric fitters such as EMS.
     Superquadric,
+}
+
+impl Family {
+    /// What one of the family is called.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Supershape => "supershape",
+            Family::Superquadric => "superquadric",
+        }
+    }
 }
 
 /// What the recovery may assume and do.
@@ -290,6 +300,22 @@ impl Envelope {
     }
 }
 
+/// The smallest and largest coordinates of the points, per axis.
+fn extent(points: impl Iterator<Item = Vector3<f64>>) -> (Vector3<f64>, Vector3<f64>) {
+    points.fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(low, high), p| (low.inf(&p), high.sup(&p)),
+    )
+}
+
+/// The extent of the points along the axes of `frame` (its columns: its axes in the points' frame).
+fn extent_in(points: &[Point3<f64>], frame: &Rotation3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    extent(points.iter().map(|p| frame.inverse() * p.coords))
+}
+
 /// At most `count` of the points, evenly taken.
 fn evenly(points: &[Point3<f64>], count: usize) -> Vec<Point3<f64>> {
     if points.len() > count {
@@ -395,16 +421,7 @@ fn bounding_box(
     normalisation: &Normalisation,
 ) -> Node {
     let rotation = envelope.rotation();
-    let (low, high) = points.iter().fold(
-        (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        ),
-        |(low, high), p| {
-            let local = rotation.inverse() * p.coords;
-            (low.inf(&local), high.sup(&local))
-        },
-    );
+    let (low, high) = extent_in(points, &rotation);
     let half = ((high - low) / 2.0).add_scalar(margin) * normalisation.scale;
     let middle = normalisation.centre + rotation * ((low + high) / 2.0) * normalisation.scale;
     let place = Isometry3::from_parts(

@@ -1,14 +1,15 @@
 //! Parts of several segments (seed 001 section 6.3): "since segmented data can be seen as the union of several
 //! parts, the union of the reconstructed parts can be transcribed into a single analytical equation using
 //! R-functions", R_p with p = 2. Each segment is recovered on its own as a truncated supershape (its points show
-//! only the part's outside, so the envelope is cut to where they are), with its holes, and the recovered solids
+//! only the part's outside, so the envelope is cut to where they are, unless the options say not to truncate),
+//! with its holes, and the recovered solids
 //! are joined by union; the global error of fit (eq. 15) is the whole object's, over every segment's points.
 //! The segmentation itself is the scan's (a label per point), as in the paper, which takes it from a mesh
 //! segmentation.
 
 use nalgebra::Point3;
 
-use super::{global_error, recover, Recovered, RecoveryError, RecoveryOptions};
+use super::{global_error, recover, Recovered, RecoveryError, RecoveryOptions, MIN_POINTS};
 use crate::geometry::supershape::csg::{Node, Solid};
 use crate::geometry::supershape::rfunc::{Boolean, RFunction};
 
@@ -52,6 +53,15 @@ pub fn recover_segments(
     options: &RecoveryOptions,
     starting: &mut dyn FnMut(usize, &SegmentPoints),
 ) -> Result<RecoveredObject, SegmentError> {
+    // A segment too small to fit is told before the others' recoveries take their seconds.
+    if let Some(small) = segments.iter().find(|s| s.points.len() < MIN_POINTS) {
+        return Err(SegmentError::Segment {
+            label: small.label.clone(),
+            error: RecoveryError::TooFewPoints {
+                got: small.points.len(),
+            },
+        });
+    }
     let recovered: Vec<RecoveredSegment> = segments
         .iter()
         .enumerate()
@@ -199,14 +209,20 @@ mod tests {
             "{agree} of {trials} agree"
         );
         assert!(object.global_error.is_finite() && object.global_error > 0.0);
+        // A segment too small to fit is refused by name before any segment's recovery starts.
+        let mut started = 0;
         let refused = recover_segments(
-            &[SegmentPoints {
-                label: "burr".into(),
-                points: all[..10].to_vec(),
-            }],
+            &[
+                segments[0].clone(),
+                SegmentPoints {
+                    label: "burr".into(),
+                    points: all[..10].to_vec(),
+                },
+            ],
             &RecoveryOptions::default(),
-            &mut |_, _| {},
+            &mut |_, _| started += 1,
         );
+        assert_eq!(started, 0);
         assert_eq!(
             refused.unwrap_err().to_string(),
             "segment 'burr': 10 points cannot fix a supershape; give at least 60 points spread over the part's surface"

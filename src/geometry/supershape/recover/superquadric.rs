@@ -10,17 +10,19 @@
 //! every inertia axis with both its turns is a start: six short minimisations on a subsample, the best refined on
 //! every point.
 
-use nalgebra::{Point3, Rotation3, Vector3};
+use nalgebra::{Point3, Rotation3};
 use num_dual::DualNum;
 use rayon::prelude::*;
 
 use super::model::{self, Candidate, Frame, PARAMS, SMALLEST_EXPONENT};
 use super::problem::{minimise_model, Residual};
-use super::{evenly, rms_radial, symmetry, Fitted, RecoveryError, EARLY_POINTS, STANDARD_PATIENCE};
+use super::{
+    evenly, extent_in, rms_radial, symmetry, Fitted, RecoveryError, EARLY_POINTS, STANDARD_PATIENCE,
+};
 
 /// Centre (3), turn from the start frame as a Gibbs vector (3), logarithms of the sizes (3), and the exponents
 /// across and along the axis as l with n = `SMALLEST_EXPONENT` + exp(l): the supershape's parameters with r1's
-/// three exponents one and r2's three one.
+/// three exponents tied to one value and r2's three to another.
 const SUPERQUADRIC_PARAMS: usize = 11;
 /// The starts' exponents: n = 2 (an ellipsoid, epsilon = 1, as Solina and Bajcsy start).
 const START_EXPONENT: f64 = 2.0;
@@ -89,16 +91,7 @@ fn parameters(candidate: &Candidate) -> [f64; SUPERQUADRIC_PARAMS] {
 
 /// A start on the frame `start`: centre and half sizes from the points' extent along its axes, an ellipsoid.
 fn start_on(points: &[Point3<f64>], start: Rotation3<f64>) -> [f64; SUPERQUADRIC_PARAMS] {
-    let (low, high) = points.iter().fold(
-        (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        ),
-        |(low, high), p| {
-            let local = start.inverse() * p.coords;
-            (low.inf(&local), high.sup(&local))
-        },
-    );
+    let (low, high) = extent_in(points, &start);
     let centre = start * ((low + high) / 2.0);
     let half = (high - low) / 2.0;
     let l = model::exponent_parameter(START_EXPONENT);
@@ -191,7 +184,20 @@ mod tests {
                 let t = k as f64 * 0.37;
                 Point3::new(1.1 * t.sin(), 0.8 * (1.3 * t).cos(), 0.6 * (0.7 * t).sin())
             })
-            .chain([Point3::new(0.1, -0.2, 0.05), Point3::new(0.1, -0.2, 0.7)])
+            .collect()
+    }
+
+    /// The centre and points on the canonical axes, where coordinates of q are exactly 0 (the norm's kinks).
+    fn special_points() -> Vec<Point3<f64>> {
+        let p = params();
+        let rotation = candidate(start(), &p).rotation();
+        let centre = Point3::new(p[0], p[1], p[2]);
+        let a = [p[6].exp(), p[7].exp(), p[8].exp()];
+        [[0.0; 3], [0.0, 0.0, 0.3], [0.5, 0.0, 0.0], [0.0, -1.4, 0.0]]
+            .iter()
+            .map(|t| {
+                centre + rotation * nalgebra::Vector3::new(t[0] * a[0], t[1] * a[1], t[2] * a[2])
+            })
             .collect()
     }
 
@@ -202,7 +208,7 @@ mod tests {
         let p = params();
         let model = Superquadric { start: start() };
         let tied = candidate(start(), &p);
-        for point in points() {
+        for point in points().into_iter().chain(special_points()) {
             let mine = model.residual(&p, &point);
             let theirs =
                 model::residual(&tied.frame, model::Radius::Standard, &tied.params, &point);
@@ -214,14 +220,25 @@ mod tests {
         assert_eq!(parameters(&tied), p);
     }
 
-    /// The dual numbers' Jacobian of the closed form matches central differences in every parameter.
+    /// The dual numbers' Jacobian of the closed form matches central differences in every parameter, and is
+    /// finite at the centre and on the axes, where the norm has kinks (a NaN there would stop the solver).
     #[test]
     fn dual_jacobians_match_central_differences() {
         let p = params();
         let model = Superquadric { start: start() };
         let duals: [DualSVec64<SUPERQUADRIC_PARAMS>; SUPERQUADRIC_PARAMS] =
             std::array::from_fn(|j| DualSVec64::from_re(p[j]).derivative(j));
-        for point in points().iter().step_by(11) {
+        for point in &special_points() {
+            let gradient = model.residual(&duals, point).eps;
+            assert!(
+                gradient
+                    .unwrap_generic(Const::<SUPERQUADRIC_PARAMS>, Const::<1>)
+                    .iter()
+                    .all(|g| g.is_finite()),
+                "{point}"
+            );
+        }
+        for point in &points() {
             let gradient = model
                 .residual(&duals, point)
                 .eps

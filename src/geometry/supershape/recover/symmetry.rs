@@ -81,7 +81,7 @@ fn guess_about(
             Vector3::new(d.dot(&u), d.dot(&v), d.dot(&w))
         })
         .collect();
-    let (low, high) = extent(&local);
+    let (low, high) = super::extent(local.iter().copied());
     let middle = (low + high) / 2.0;
     let half = (high - low) / 2.0;
     let slabs = slab_lobes(&local);
@@ -111,17 +111,6 @@ fn guess_about(
         detected,
         agreement,
     }
-}
-
-/// The smallest and largest coordinates of the points, per axis.
-fn extent(local: &[Vector3<f64>]) -> (Vector3<f64>, Vector3<f64>) {
-    local.iter().fold(
-        (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        ),
-        |(low, high), p| (low.inf(p), high.sup(p)),
-    )
 }
 
 /// The lobes of each slab across the z axis of the local frame that has enough points and stands out.
