@@ -125,10 +125,7 @@ fn whole(
         recovered.global_error
     );
     describe(args, &recovered);
-    let method = format!(
-        "{what} recovery (seed 001): {}",
-        how_found(args, &recovered)
-    );
+    let method = format!("{what} recovery (seed 001): {}", how_found(&recovered));
     Ok((recovered.solid, method))
 }
 
@@ -172,7 +169,7 @@ fn segmented(
         found.push(format!(
             "segment '{}': {}",
             segment.label,
-            how_found(args, &segment.recovered)
+            how_found(&segment.recovered)
         ));
     }
     let method = format!(
@@ -184,16 +181,8 @@ fn segmented(
 }
 
 /// The search behind one recovery, for the model file.
-fn how_found(args: &FitSupershapeArgs, recovered: &Recovered) -> String {
-    let how = |k: usize| {
-        if args.symmetry.is_some() || args.superquadric {
-            "given"
-        } else if recovered.symmetry_read[k] {
-            "read from the points"
-        } else {
-            "4: nothing stood out"
-        }
-    };
+fn how_found(recovered: &Recovered) -> String {
+    let how = |k: usize| recovered.symmetry_source[k].describe();
     format!(
         "Levenberg-Marquardt on the radial cost, {} starts, symmetry m1 = {} ({}), m2 = {} ({})",
         recovered.starts,

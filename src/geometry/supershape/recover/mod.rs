@@ -47,6 +47,17 @@ const RATIONAL_PATIENCE: usize = 4;
 const STANDARD_PATIENCE: usize = 100;
 /// The best starts after the rational stage that the standard stage refines.
 const REFINED_STARTS: usize = 4;
+/// The latitude symmetry numbers m2 tried from the refined fit when they are not given (`starts::other_latitudes`).
+const LATITUDES: [u32; 4] = [2, 4, 6, 8];
+/// The section symmetry numbers m1 tried from the refined fit when they are not given (`starts::other_sections`).
+const SECTION_COUNTS: [u32; 6] = [3, 4, 5, 6, 7, 8];
+/// The brief minimisation of each other-symmetry candidate (x 16 evaluations), and how many are refined.
+const SWITCH_PATIENCE: usize = 4;
+/// The brief minimisations run on this many of the subsample's points.
+const SWITCH_POINTS: usize = 200;
+const SWITCH_REFINED: usize = 2;
+/// The fraction by which another symmetry's fit must come nearer the points than the fit read.
+const SWITCH_GAIN: f64 = 0.1;
 /// The truncating box lies this many RMS radial distances outside the points (at least this fraction of the
 /// points' RMS radius), so that it cuts away only what lies beyond the data, never the data's own surface.
 const BOX_MARGIN_RMS: f64 = 4.0;
@@ -124,8 +135,8 @@ pub struct Recovered {
     pub holes: Vec<RecoveredHole>,
     /// The envelope's symmetry numbers m1, m2.
     pub symmetry: [u32; 2],
-    /// Whether each was read from the points (false when given, or when it fell back to 4).
-    pub symmetry_read: [bool; 2],
+    /// Where each came from.
+    pub symmetry_source: [SymmetrySource; 2],
     /// The starts tried for the envelope.
     pub starts: usize,
     /// Seed 001 eq. 15 at the points, mm^3.
@@ -133,6 +144,31 @@ pub struct Recovered {
     /// The RMS of the envelope's radial distances |P| |F2| / (1 - F2) at its points, mm: an upper bound of
     /// their Euclidean distances (the radial foot is a point of the surface).
     pub rms_radial_mm: f64,
+}
+
+/// Where a recovered symmetry number came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SymmetrySource {
+    /// Given in the options (or fixed by the family: a superquadric's are 4, 4).
+    Given,
+    /// Read from the lobes of the points' sections.
+    Read,
+    /// Another number than the one read (or than 4) fitted the points better, and the fit switched to it.
+    Switched,
+    /// Nothing stood out, so 4, which eq. 1 makes transparent.
+    Transparent,
+}
+
+impl SymmetrySource {
+    /// How the number was found, in words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            SymmetrySource::Given => "given",
+            SymmetrySource::Read => "read from the points",
+            SymmetrySource::Switched => "fitted better than the one read",
+            SymmetrySource::Transparent => "4: nothing stood out",
+        }
+    }
 }
 
 /// A hole of the recovered solid.
@@ -183,12 +219,12 @@ impl Normalisation {
     }
 }
 
-/// One supershape fitted to points of the normalised frame, with the number of starts tried and whether both
-/// symmetry numbers were read from the points.
+/// One supershape fitted to points of the normalised frame, with the number of starts tried and where its
+/// symmetry numbers came from.
 struct Fitted {
     candidate: Candidate,
     starts: usize,
-    read: [bool; 2],
+    source: [SymmetrySource; 2],
 }
 
 /// Recovers a solid from points on a part's surface (mm).
@@ -265,7 +301,7 @@ pub fn recover(
         envelope: (shape, place),
         holes,
         symmetry: envelope.candidate.frame.symmetry,
-        symmetry_read: envelope.read,
+        symmetry_source: envelope.source,
         starts: envelope.starts,
         rms_radial_mm: rms_radial * normalisation.scale,
         solid,
@@ -329,7 +365,8 @@ fn evenly(points: &[Point3<f64>], count: usize) -> Vec<Point3<f64>> {
 
 /// One supershape fitted to normalised points: every start of every inertia axis's guess minimised briefly on a
 /// subsample (the rational radius where it stands for the superformula), the best few refined with the
-/// superformula on the subsample, and the best of those refined on every point.
+/// superformula on the subsample; then, unless the symmetry numbers are given, the best of those tried with the
+/// other likely numbers (`best_switch`); and the best of all refined on every point.
 ///
 /// Starts are compared by their RMS radial distance to the points, not by the cost they minimise: eq. 4's
 /// volume term a1 a2 a3 has a degenerate minimum, a supershape shrunk to a point far from the data (there F2
@@ -363,22 +400,79 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
         .collect();
     tried.sort_by(|a, b| a.0.total_cmp(&b.0));
     tried.truncate(REFINED_STARTS);
-    let (_, best, read) = tried
+    let refine = |candidate: Candidate| {
+        let (reached, _) = minimise(&early, candidate, Radius::Standard, STANDARD_PATIENCE)?;
+        let distance = rms_distance(&reached, &early);
+        distance.is_finite().then_some((distance, reached))
+    };
+    let (distance, mut best, read) = tried
         .into_par_iter()
-        .filter_map(|(_, candidate, read)| {
-            let (reached, _) = minimise(&early, candidate, Radius::Standard, STANDARD_PATIENCE)?;
-            let distance = rms_distance(&reached, &early);
-            distance.is_finite().then_some((distance, reached, read))
-        })
+        .filter_map(|(_, candidate, read)| refine(candidate).map(|(d, c)| (d, c, read)))
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .ok_or(RecoveryError::NoConvergence { starts: count })?;
+    let mut source = match given {
+        Some(_) => [SymmetrySource::Given; 2],
+        None => read.map(|read| {
+            if read {
+                SymmetrySource::Read
+            } else {
+                SymmetrySource::Transparent
+            }
+        }),
+    };
+    if given.is_none() {
+        // Symmetry numbers read from the points are the commonest misses: the fit switches to other ones when
+        // they come nearer the points, m2 first (r1 is usually right by then), then m1.
+        let mut distance = distance;
+        let latitudes = starts::other_latitudes(&early, &best, &LATITUDES);
+        if let Some((d, candidate)) = best_switch(&early, latitudes, &refine, (&best, distance)) {
+            (distance, best) = (d, candidate);
+            source[1] = SymmetrySource::Switched;
+        }
+        let sections = starts::other_sections(&best, &SECTION_COUNTS);
+        if let Some((_, candidate)) = best_switch(&early, sections, &refine, (&best, distance)) {
+            best = candidate;
+            source[0] = SymmetrySource::Switched;
+        }
+    }
     let (candidate, _) = minimise(points, best, Radius::Standard, STANDARD_PATIENCE)
         .ok_or(RecoveryError::NoConvergence { starts: count })?;
     Ok(Fitted {
         candidate,
         starts: count,
-        read,
+        source,
     })
+}
+
+/// The best of other-symmetry candidates when it comes clearly nearer the points than `distance` (by
+/// `SWITCH_GAIN`): each minimised briefly, and of those already nearer by radial distance than the current fit
+/// the nearest `SWITCH_REFINED` refined (`refine`, which gives the RMS distance). Where the numbers read are
+/// right no other one gets that near in a brief minimisation, and the switch costs only those. A misread number leaves the fit far off (twice the noise and more in the
+/// seeded cases); where the number does not matter (a round section is round for every m1) a marginal gain
+/// would trade the shape read for a degenerate one of extreme exponents.
+fn best_switch(
+    early: &[Point3<f64>],
+    candidates: Vec<Candidate>,
+    refine: &(impl Fn(Candidate) -> Option<(f64, Candidate)> + Sync),
+    (current, distance): (&Candidate, f64),
+) -> Option<(f64, Candidate)> {
+    let few = evenly(early, SWITCH_POINTS);
+    let current_radial = rms_radial(current, &few);
+    let mut brief: Vec<(f64, Candidate)> = candidates
+        .into_par_iter()
+        .filter_map(|candidate| {
+            let (reached, _) = minimise(&few, candidate, Radius::Standard, SWITCH_PATIENCE)?;
+            let radial = rms_radial(&reached, &few);
+            (radial < current_radial).then_some((radial, reached))
+        })
+        .collect();
+    brief.sort_by(|a, b| a.0.total_cmp(&b.0));
+    brief.truncate(SWITCH_REFINED);
+    brief
+        .into_par_iter()
+        .filter_map(|(_, candidate)| refine(candidate))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .filter(|(d, _)| *d < (1.0 - SWITCH_GAIN) * distance)
 }
 
 /// The radial distance |P - I| = |P| |F2| / (1 - F2) of a point to a placed supershape, I the surface point on

@@ -87,6 +87,80 @@ pub(super) fn of(
     starts
 }
 
+/// Starts with other latitude symmetry numbers m2 from a fitted candidate: its centre, turn, sizes and r1 kept,
+/// r2 round, boxy and read from the points for each m2 of `latitudes` other than its own. The meridian's lobes
+/// are read from few points near two planes and often missed (a misread m2 was half of the seeded misses), while
+/// r1 is usually right by then; trying every likely m2 from the fitted r1 is cheaper than from every start.
+pub(super) fn other_latitudes(
+    points: &[Point3<f64>],
+    fitted: &Candidate,
+    latitudes: &[u32],
+) -> Vec<Candidate> {
+    let exponents = fitted.exponents();
+    let start = LobedStart {
+        rotation: fitted.rotation(),
+        centre: Vector3::new(fitted.params[0], fitted.params[1], fitted.params[2]),
+        sizes: fitted.sizes(),
+        r1: [exponents[0], exponents[1], exponents[2]],
+    };
+    let [m1, own] = fitted.frame.symmetry;
+    latitudes
+        .iter()
+        .filter(|&&m2| m2 != own)
+        .flat_map(|&m2| {
+            let read = meridian_exponents(points, &start, m1, m2);
+            MERIDIAN_STARTS
+                .iter()
+                .map(|n| [*n; 3])
+                .chain(read)
+                .map(move |meridian| {
+                    let mut params = fitted.params;
+                    params[12..].copy_from_slice(&meridian.map(model::exponent_parameter));
+                    Candidate {
+                        frame: Frame {
+                            symmetry: [m1, m2],
+                            start: fitted.frame.start,
+                        },
+                        params,
+                    }
+                })
+        })
+        .collect()
+}
+
+/// Starts with other symmetry numbers m1 from a fitted candidate: for each m1 of `counts` other than its own,
+/// its centre, axis, sizes and r2 kept, and r1 as the axis guesses' lobed starts (`LOBED_STARTS`) at the two
+/// turns about the axis where a lobe's maximum may sit (0 and half a lobe, pi / m1). A section's lobes are misread
+/// where its outline is nearly round or its lobes are weak (3 read as 6, 8 as 4 in the seeded cases), while the
+/// axis is usually right.
+pub(super) fn other_sections(fitted: &Candidate, counts: &[u32]) -> Vec<Candidate> {
+    let [own, m2] = fitted.frame.symmetry;
+    let rotation = fitted.rotation();
+    counts
+        .iter()
+        .filter(|&&m1| m1 != own)
+        .flat_map(|&m1| {
+            [0.0, std::f64::consts::PI / f64::from(m1)]
+                .into_iter()
+                .flat_map(move |turn| {
+                    LOBED_STARTS.iter().map(move |&n| {
+                        let mut params = fitted.params;
+                        params[3..6].fill(0.0);
+                        params[9..12].fill(model::exponent_parameter(n));
+                        Candidate {
+                            frame: Frame {
+                                symmetry: [m1, m2],
+                                start: rotation
+                                    * Rotation3::from_axis_angle(&Vector3::z_axis(), turn),
+                            },
+                            params,
+                        }
+                    })
+                })
+        })
+        .collect()
+}
+
 /// r2's exponents read from the points for a start: each point in the start's frame gives, through eq. 8 with the
 /// start's r1 and sizes, its latitude phi and the radius r2(phi) it asks for; the exponents of a coarse grid (n1 from
 /// 1 to 16, n2 and n3 from 0.7 to 12, on up to `SECTION_POINTS` points) that best give those radii. A meridian's two flanks

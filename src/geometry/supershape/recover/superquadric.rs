@@ -17,7 +17,8 @@ use rayon::prelude::*;
 use super::model::{self, Candidate, Frame, PARAMS, SMALLEST_EXPONENT};
 use super::problem::{minimise_model, Residual};
 use super::{
-    evenly, extent_in, rms_radial, symmetry, Fitted, RecoveryError, EARLY_POINTS, STANDARD_PATIENCE,
+    evenly, extent_in, rms_radial, symmetry, Fitted, RecoveryError, SymmetrySource, EARLY_POINTS,
+    STANDARD_PATIENCE,
 };
 
 /// Centre (3), turn from the start frame as a Gibbs vector (3), logarithms of the sizes (3), and the exponents
@@ -139,7 +140,7 @@ pub(super) fn fit(points: &[Point3<f64>]) -> Result<Fitted, RecoveryError> {
     Ok(Fitted {
         candidate,
         starts: count,
-        read: [false; 2],
+        source: [SymmetrySource::Given; 2],
     })
 }
 
