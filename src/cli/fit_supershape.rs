@@ -156,11 +156,11 @@ fn segmented(
         object.global_error
     );
     let mut found = Vec::new();
-    for (segment, points) in object.segments.iter().zip(segments) {
+    for (segment, scanned) in object.segments.iter().zip(segments) {
         println!(
             "  segment '{}': {} points, symmetry {},{}, global error {:.4e} mm^3",
             segment.label,
-            points.points.len(),
+            scanned.points.len(),
             segment.recovered.symmetry[0],
             segment.recovered.symmetry[1],
             segment.recovered.global_error

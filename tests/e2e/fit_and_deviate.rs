@@ -243,14 +243,7 @@ fn a_supershape_recovered_from_3d_points_measures_an_offset_surface() {
     ellipsoid_csv(&master, 2000, 0.0);
     ellipsoid_csv(&part, 300, 0.25);
     let model = dir.path().join("supershape.json");
-    let printed = crate::support::zeroset_ok(&[
-        "fit",
-        "supershape",
-        "--points",
-        master.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let printed = fit_supershape_ok(&master, &model, &[]);
     assert!(
         printed.contains("2000 points") && printed.contains("symmetry 4,4"),
         "{printed}"
@@ -296,6 +289,35 @@ fn superquadric_csv(path: &std::path::Path, count: usize) {
     std::fs::write(path, text).unwrap();
 }
 
+/// `zeroset fit supershape --points POINTS --out MODEL` with `extra` options.
+fn fit_supershape(
+    points: &std::path::Path,
+    model: &std::path::Path,
+    extra: &[&str],
+) -> crate::support::Run {
+    let mut args = vec![
+        "fit",
+        "supershape",
+        "--points",
+        points.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    crate::support::zeroset(&args)
+}
+
+/// `fit_supershape` that must succeed; what it printed.
+fn fit_supershape_ok(points: &std::path::Path, model: &std::path::Path, extra: &[&str]) -> String {
+    let run = fit_supershape(points, model, extra);
+    assert!(
+        run.success,
+        "zeroset fit supershape {extra:?} failed:\n{}\n{}",
+        run.stdout, run.stderr
+    );
+    run.stdout
+}
+
 /// The RMS of the exact distances `zeroset fit supershape` prints, mm.
 fn printed_rms_mm(printed: &str) -> f64 {
     printed
@@ -315,17 +337,11 @@ fn a_superquadric_is_recovered_with_its_sizes_and_exponents() {
     let points = dir.path().join("box.csv");
     superquadric_csv(&points, 2000);
     let model = dir.path().join("box.json");
-    let printed = crate::support::zeroset_ok(&[
-        "fit",
-        "supershape",
-        "--superquadric",
-        "--no-truncation",
-        "--no-holes",
-        "--points",
-        points.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let printed = fit_supershape_ok(
+        &points,
+        &model,
+        &["--superquadric", "--no-truncation", "--no-holes"],
+    );
     let line = printed
         .lines()
         .find(|l| l.contains("superquadric: sizes"))
@@ -347,17 +363,7 @@ fn a_superquadric_is_recovered_with_its_sizes_and_exponents() {
     assert!(printed.contains("symmetry 4,4"), "{printed}");
     let rms = printed_rms_mm(&printed);
     assert!(rms < 1e-3, "RMS {rms} mm for exact points: {printed}");
-    let refused = crate::support::zeroset(&[
-        "fit",
-        "supershape",
-        "--superquadric",
-        "--symmetry",
-        "6,4",
-        "--points",
-        points.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let refused = fit_supershape(&points, &model, &["--superquadric", "--symmetry", "6,4"]);
     assert!(
         !refused.success
             && refused
@@ -412,14 +418,7 @@ fn a_segmented_scan_is_recovered_as_the_union_of_its_segments() {
     )
     .unwrap();
     let model = dir.path().join("segments.json");
-    let printed = crate::support::zeroset_ok(&[
-        "fit",
-        "supershape",
-        "--points",
-        points.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let printed = fit_supershape_ok(&points, &model, &[]);
     assert!(
         printed.contains("2 segments of")
             && printed.contains("segment 'body'")
@@ -442,14 +441,7 @@ fn a_segmented_scan_is_recovered_as_the_union_of_its_segments() {
         ),
     )
     .unwrap();
-    let refused = crate::support::zeroset(&[
-        "fit",
-        "supershape",
-        "--points",
-        points.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let refused = fit_supershape(&points, &model, &[]);
     assert!(
         !refused.success
             && refused

@@ -349,7 +349,8 @@ fn extent(points: impl Iterator<Item = Vector3<f64>>) -> (Vector3<f64>, Vector3<
 
 /// The extent of the points along the axes of `frame` (its columns: its axes in the points' frame).
 fn extent_in(points: &[Point3<f64>], frame: &Rotation3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    extent(points.iter().map(|p| frame.inverse() * p.coords))
+    let inverse = frame.inverse();
+    extent(points.iter().map(|p| inverse * p.coords))
 }
 
 /// At most `count` of the points, evenly taken.
@@ -405,7 +406,7 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
         let distance = rms_distance(&reached, &early);
         distance.is_finite().then_some((distance, reached))
     };
-    let (distance, mut best, read) = tried
+    let (mut distance, mut best, read) = tried
         .into_par_iter()
         .filter_map(|(_, candidate, read)| refine(candidate).map(|(d, c)| (d, c, read)))
         .min_by(|a, b| a.0.total_cmp(&b.0))
@@ -423,7 +424,6 @@ fn fit_one(points: &[Point3<f64>], given: Option<[u32; 2]>) -> Result<Fitted, Re
     if given.is_none() {
         // Symmetry numbers read from the points are the commonest misses: the fit switches to other ones when
         // they come nearer the points, m2 first (r1 is usually right by then), then m1.
-        let mut distance = distance;
         let latitudes = starts::other_latitudes(&early, &best, &LATITUDES);
         if let Some((d, candidate)) = best_switch(&early, latitudes, &refine, (&best, distance)) {
             (distance, best) = (d, candidate);
