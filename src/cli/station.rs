@@ -8,7 +8,7 @@ use clap::Args;
 
 use super::control::{accepted, Control};
 use super::watch::{JobEnd, Watch};
-use crate::api::{Reply, Request, StationStatus};
+use crate::api::{JobKind, JobPhase, Reply, Request, StationStatus};
 use crate::config::StationConfig;
 
 /// The station file, shared by every station command.
@@ -178,12 +178,7 @@ pub fn watch(args: &WatchArgs) -> anyhow::Result<()> {
     if !args.events {
         print_status(&status);
     }
-    let job = status
-        .job
-        .filter(|j| {
-            !["finished", "aborted"].contains(&j.state.as_str()) && !j.state.starts_with("failed")
-        })
-        .map(|j| j.job.id);
+    let job = status.job.filter(|j| !j.state.is_over()).map(|j| j.job.id);
     follow(events, job, args.events, args.follow).map(drop)
 }
 
@@ -229,27 +224,50 @@ pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
     }
 }
 
+fn kind_name(kind: JobKind) -> &'static str {
+    match kind {
+        JobKind::Teach => "teach",
+        JobKind::Inspect => "inspect",
+    }
+}
+
 fn print_status(status: &StationStatus) {
     println!("station {}", status.station);
     for machine in &status.machines {
         println!("  machine {}: {}", machine.name, machine.state);
     }
+    if let Some(preparing) = &status.preparing {
+        println!(
+            "  setting up: {} {}{}",
+            kind_name(preparing.kind),
+            preparing.part,
+            preparing
+                .serial
+                .as_ref()
+                .map_or(String::new(), |s| format!(" serial {s}"))
+        );
+    }
     match &status.job {
         Some(job) => {
+            let phase = match &job.state {
+                JobPhase::Stopped { .. } => "stopped".to_string(),
+                JobPhase::Failed { .. } => "failed".to_string(),
+                other => other.to_string(),
+            };
             println!(
-                "  job {} ({} {}): {}, {}/{} profiles done",
+                "  job {} ({} {}): {phase}, {}/{} profiles done",
                 job.job.id,
-                match job.job.kind {
-                    crate::api::JobKind::Teach => "teach",
-                    crate::api::JobKind::Inspect => "inspect",
-                },
+                kind_name(job.job.kind),
                 job.job.part,
-                job.state,
                 job.profiles_done,
                 job.profiles_total
             );
-            if let Some(stopped) = &job.stopped {
-                println!("  stopped: {stopped}");
+            match &job.state {
+                JobPhase::Stopped {
+                    reason, next_step, ..
+                } => println!("  stopped: {reason}; {next_step}"),
+                JobPhase::Failed { error } => println!("  failed: {error}"),
+                _ => {}
             }
         }
         None => println!("  no job"),

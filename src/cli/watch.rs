@@ -120,10 +120,11 @@ impl Watch {
                 self.finish_bars();
                 self.line(format!("reference saved: {}", path.display()));
                 for fit in profiles {
-                    self.line(format!(
-                        "  {}: {} points, fit RMS {:.4} mm, max {:.4} mm",
-                        fit.profile, fit.points, fit.rms_mm, fit.max_mm
-                    ));
+                    let distance = match (fit.rms_mm, fit.max_mm) {
+                        (Some(rms), Some(max)) => format!("fit RMS {rms:.4} mm, max {max:.4} mm"),
+                        _ => "no fit distances kept by this reference kind".to_string(),
+                    };
+                    self.line(format!("  {}: {} points, {distance}", fit.profile, fit.points));
                 }
                 return Some(JobEnd::Finished { passed: None });
             }

@@ -12,8 +12,8 @@
 
 use nalgebra::Point3;
 
-use super::escape::{way_out, KnownPath};
-use super::job::{job_scans, load_plan, reference_path, scan_margin_mm};
+use super::job::{job_scans, load_plan, reference_path};
+use super::motion::{job_motions, Scan, ScanMotion};
 use crate::analysis::part_mesh::part_mesh;
 use crate::analysis::Reference;
 use crate::api::JobKind;
@@ -90,66 +90,55 @@ pub fn machine_part(plan: &Plan, reference: &Reference) -> Result<MeshPart, Stri
         .map_err(|e| format!("the model of part '{}': {e}", plan.part()))
 }
 
-/// Every move of an inspection near the part, in scan order: descent, contact scan, way out, per profile.
-pub fn inspection_moves(
-    plan: &Plan,
-    reference: &Reference,
-    keys: &[ProfileKey],
-    ball_radius_mm: f64,
-    margin_mm: f64,
-    clearance_z_mm: f64,
-) -> Result<Vec<PlannedMove>, String> {
+/// Every planned move near the part, in scan order: descent, contact scan (a curve scan's), lift-off and way out,
+/// per profile: the very positions the worker sends.
+pub fn swept_moves(motions: &[ScanMotion]) -> Result<Vec<PlannedMove>, String> {
     let mut moves = Vec::new();
-    for &key in keys {
-        let scan = plan.curve_scan(key, &reference.profiles[key.profile].nominals);
-        let path = KnownPath::of_curve_scan(&scan);
-        let entry = path.entry_offset(ball_radius_mm, margin_mm);
-        let above = Point3::new(entry.x, entry.y, clearance_z_mm);
+    for motion in motions {
+        let key = motion.key;
+        let [above, entry] = motion.approach;
         moves.push(PlannedMove {
             key,
             kind: MoveKind::Descent,
             motion: Motion::line(above, entry),
         });
-        let centres: Vec<Point3<f64>> = path
-            .surface
-            .iter()
-            .zip(&path.normals)
-            .map(|(p, n)| p + n * ball_radius_mm)
-            .chain(
-                path.closed
-                    .then(|| path.surface[0] + path.normals[0] * ball_radius_mm),
-            )
-            .collect();
-        let last = *centres.last().expect("a curve scan has nominals");
-        let scan_path = ScanPath::new(centres, true).map_err(|e| {
-            format!(
-                "{}: the scan path of profile {}: {e}",
-                plan.part(),
-                plan.profile_names()[key.profile]
-            )
-        })?;
-        moves.push(PlannedMove {
-            key,
-            kind: MoveKind::Scan,
-            motion: Motion::Scan(scan_path),
-        });
-        let waypoints = way_out(last, Some(&path), ball_radius_mm, margin_mm, clearance_z_mm)
-            .map_err(|e| e.to_string())?;
-        let mut from = last;
-        for to in waypoints {
+        if let Scan::Curve(_) = motion.scan {
+            let path = &motion.path;
+            let radius = motion.ball_radius_mm;
+            let centres: Vec<Point3<f64>> = path
+                .surface
+                .iter()
+                .zip(&path.normals)
+                .map(|(p, n)| p + n * radius)
+                .chain(
+                    path.closed
+                        .then(|| path.surface[0] + path.normals[0] * radius),
+                )
+                .collect();
+            let scan_path = ScanPath::new(centres, true)
+                .map_err(|e| format!("the scan path of {}: {e}", motion.name))?;
+            moves.push(PlannedMove {
+                key,
+                kind: MoveKind::Scan,
+                motion: Motion::Scan(scan_path),
+            });
+        }
+        let mut from = motion.end;
+        for (leg, &to) in motion.retract.iter().enumerate() {
             if (to - from).norm() > 0.0 {
                 // The first leg starts with the ball on the surface: like the scan, only the shank is judged.
-                let motion = if from == last {
-                    Motion::Scan(ScanPath::new(vec![from, to], true).map_err(|e| e.to_string())?)
+                let (kind, swept) = if leg == 0 {
+                    let lift = ScanPath::new(vec![from, to], true)
+                        .map_err(|e| format!("the lift-off of {}: {e}", motion.name))?;
+                    (MoveKind::LiftOff, Motion::Scan(lift))
                 } else {
-                    Motion::line(from, to)
+                    (MoveKind::WayOut, Motion::line(from, to))
                 };
-                let kind = if from == last {
-                    MoveKind::LiftOff
-                } else {
-                    MoveKind::WayOut
-                };
-                moves.push(PlannedMove { key, kind, motion });
+                moves.push(PlannedMove {
+                    key,
+                    kind,
+                    motion: swept,
+                });
             }
             from = to;
         }
@@ -191,14 +180,14 @@ pub fn sweep_plan(config: &StationConfig, part: &str) -> Result<PlanSweep, Strin
     })?;
     let stylus = station_stylus(config)?;
     let mesh = machine_part(&plan, &reference)?;
-    let moves = inspection_moves(
+    let motions = job_motions(
         &plan,
-        &reference,
+        Some(&reference),
         &job_scans(&plan, JobKind::Inspect),
-        stylus.ball_radius_mm,
-        scan_margin_mm(&plan, JobKind::Inspect),
-        config.safety.clearance_z_mm,
-    )?;
+        &config.safety,
+    )
+    .map_err(|e| e.to_string())?;
+    let moves = swept_moves(&motions)?;
     let moves = check_moves(&stylus, moves, &mesh, config.safety.move_margin_mm);
     Ok(PlanSweep {
         plan,

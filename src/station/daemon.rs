@@ -1,189 +1,244 @@
-//! The daemon's state: the machines, the job, and every decision about them. One task owns it and handles one
-//! message at a time, so no decision races another.
+//! The daemon's shell around its decisions (`core`): it turns messages from the control socket, the workers,
+//! the pipeline and its own blocking tasks into the core's inputs, and carries out the effects the core returns.
+//! Nothing here blocks: loading and checking a job, saving records, finishing a job and reading a report run on
+//! blocking threads and come back as messages.
 
+use std::collections::{HashMap, VecDeque};
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc, oneshot};
 
+use super::core::{Core, Effect, Input, RequestId};
 use super::finish::{self, Outcome, ReportInputs};
-use super::job::{
-    check_inspection_moves, load_plan, load_reference, reference_path, Job, JobError, Phase,
-};
-use super::journal::{open_jobs, JobState};
-use super::pipeline::{scan_ref, Pipeline, QUEUE_POINTS};
+use super::job::{prepare, reference_path, Job};
+use super::journal::{open_jobs, JobDir, JobRecord};
+use super::pipeline::{Pipeline, PipelineMsg, QUEUE_POINTS};
 use super::worker::{Order, WorkerError, WorkerHandle};
 use super::DaemonMsg;
-use crate::api::{Event, JobKind, JobStatus, MachineStatus, Reply, Request, StationStatus};
+use crate::api::{Event, FaultKind, JobKind, Reply};
 use crate::config::StationConfig;
-use crate::plan::ProfileKey;
-
-/// A machine as the daemon sees it.
-struct Slot {
-    handle: WorkerHandle,
-    state: SlotState,
-    /// Where its last scan started, for choosing the nearest next one.
-    at: Option<Point3<f64>>,
-}
-
-#[derive(Debug, Clone, PartialEq)]
-enum SlotState {
-    Idle,
-    Scanning(ProfileKey),
-    Faulted(String),
-    Clearing,
-}
 
 pub struct Daemon {
     config: Arc<StationConfig>,
-    slots: Vec<Slot>,
+    core: Core,
+    workers: HashMap<String, WorkerHandle>,
     events: broadcast::Sender<Event>,
     to_self: mpsc::Sender<DaemonMsg>,
-    job: Option<Job>,
-    /// The reply owed to a `clear` until every machine has answered.
-    clearing: Option<oneshot::Sender<Reply>>,
+    replies: HashMap<RequestId, oneshot::Sender<Reply>>,
+    next_request: RequestId,
+    /// The current job's analysis, while its machines scan.
+    pipeline: Option<mpsc::Sender<PipelineMsg>>,
+    /// Job records go to disk in the order they were decided, on one thread of their own.
+    records: std::sync::mpsc::Sender<(JobDir, JobRecord)>,
 }
 
 impl Daemon {
-    /// The daemon's state, with the newest job a previous daemon left open, stopped until `zeroset clear`.
-    pub fn start(
+    /// The daemon, with the newest job a previous daemon left open, stopped until `zeroset clear`.
+    pub async fn start(
         config: StationConfig,
         workers: Vec<WorkerHandle>,
         events: broadcast::Sender<Event>,
         to_self: mpsc::Sender<DaemonMsg>,
     ) -> anyhow::Result<Daemon> {
-        let mut open = open_jobs(&config.folders.data)?;
-        let job = match open.pop() {
-            Some((dir, record)) => {
-                let id = record.id.clone();
-                match Job::reopen(&config, dir, record) {
-                    Ok(job) => {
-                        tracing::info!(job = %id, done = job.stored.len(), total = job.total, "reopened a job left open");
-                        Some(job)
-                    }
-                    Err(error) => {
-                        tracing::error!(job = %id, %error, "cannot reopen a job left open");
-                        None
+        let config = Arc::new(config);
+        let reopened = {
+            let config = config.clone();
+            tokio::task::spawn_blocking(move || reopen(&config))
+                .await
+                .map_err(|e| anyhow::anyhow!("reopening the job left open failed: {e}"))??
+        };
+        let core = Core::new(
+            config.name.clone(),
+            workers.iter().map(|w| w.name.clone()).collect(),
+            reopened,
+        );
+        let (records, inbox) = std::sync::mpsc::channel::<(JobDir, JobRecord)>();
+        std::thread::Builder::new()
+            .name("job records".into())
+            .spawn(move || {
+                for (dir, record) in inbox {
+                    if let Err(error) = dir.save_record(&record) {
+                        tracing::error!(job = %record.id, %error, "cannot record the job's state");
                     }
                 }
-            }
-            None => None,
-        };
-        let slots = workers
-            .into_iter()
-            .map(|handle| Slot {
-                handle,
-                state: SlotState::Idle,
-                at: None,
-            })
-            .collect();
+            })?;
         Ok(Daemon {
-            config: Arc::new(config),
-            slots,
+            config,
+            core,
+            workers: workers.into_iter().map(|w| (w.name.clone(), w)).collect(),
             events,
             to_self,
-            job,
-            clearing: None,
+            replies: HashMap::new(),
+            next_request: 0,
+            pipeline: None,
+            records,
         })
     }
 
     pub async fn run(mut self, mut inbox: mpsc::Receiver<DaemonMsg>) {
         while let Some(message) = inbox.recv().await {
-            match message {
-                DaemonMsg::Request { request, reply } => self.request(request, reply).await,
-                DaemonMsg::ScanEnded {
-                    machine,
-                    key,
-                    result,
-                } => self.scan_ended(&machine, key, result),
-                DaemonMsg::Stored { job, key, result } => self.stored(&job, key, result),
-                DaemonMsg::Cleared { machine, result } => self.cleared(&machine, result),
-                DaemonMsg::Finished { job, result } => self.finished(&job, result),
-            }
-            self.dispatch();
-            self.finish_if_complete();
+            let input = self.input(message);
+            self.handle(input);
         }
     }
 
-    fn publish(&self, event: Event) {
-        let _ = self.events.send(event);
-    }
-
-    async fn request(&mut self, request: Request, reply: oneshot::Sender<Reply>) {
-        let answer = match request {
-            Request::Status => Reply::Status(self.status()),
-            Request::Teach { part } => self.start_job(JobKind::Teach, &part, None),
-            Request::Inspect { part, serial } => {
-                self.start_job(JobKind::Inspect, &part, Some(serial))
+    fn input(&mut self, message: DaemonMsg) -> Input {
+        match message {
+            DaemonMsg::Request { request, reply } => {
+                let id = self.next_request;
+                self.next_request += 1;
+                self.replies.insert(id, reply);
+                Input::Request { id, request }
             }
-            Request::Abort => self.abort(),
-            Request::Clear => {
-                self.clear(reply);
-                return;
-            }
-            Request::Report { serial } => report(&self.config, &serial),
-            // The control task answers subscriptions itself.
-            Request::Subscribe => Reply::Subscribed,
-        };
-        let _ = reply.send(answer);
-    }
-
-    fn start_job(&mut self, kind: JobKind, part: &str, serial: Option<String>) -> Reply {
-        if let Some(job) = self.job.as_ref().filter(|j| !j.is_over()) {
-            return Reply::Error {
-                message: format!(
-                    "job {} is not over ({}); wait for it, run `zeroset clear` to continue it, or `zeroset abort` to end it",
-                    job.info.id,
-                    phase_name(&job.phase)
-                ),
-            };
-        }
-        if let Some(serial) = &serial {
-            if serial.is_empty()
-                || !serial
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-                || serial.starts_with('.')
-            {
-                return Reply::Error {
-                    message: format!("serial number {serial:?}: use letters, digits, '-', '_' and '.' (it names the report's folder)"),
-                };
-            }
-        }
-        let created = (|| -> Result<Job, JobError> {
-            let plan = load_plan(&self.config, part)?;
-            let reference = match kind {
-                JobKind::Teach => None,
-                JobKind::Inspect => {
-                    let loaded = load_reference(&self.config, &plan)?;
-                    check_inspection_moves(&self.config, &plan, &loaded.0)?;
-                    Some(loaded)
-                }
-            };
-            Job::create(&self.config, kind, plan, serial, reference)
-        })();
-        match created {
-            Ok(job) => {
-                let info = job.info.clone();
-                tracing::info!(job = %info.id, kind = ?kind, part, "job started");
-                self.job = Some(job);
-                self.start_pipeline();
-                self.publish(Event::JobStarted {
-                    job: info.clone(),
-                    done: Vec::new(),
-                });
-                Reply::Started { job: info }
-            }
-            Err(error) => Reply::Error {
-                message: error.to_string(),
+            DaemonMsg::Prepared { id, result } => Input::Prepared { id, result },
+            DaemonMsg::ScanEnded {
+                machine,
+                key,
+                result,
+            } => Input::ScanEnded {
+                machine,
+                key,
+                result,
             },
+            DaemonMsg::Stored { job, key, result } => Input::Stored { job, key, result },
+            DaemonMsg::Cleared { machine, result } => Input::Cleared { machine, result },
+            DaemonMsg::Finished { job, result } => Input::Finished { job, result },
         }
+    }
+
+    /// Hands `input` to the core and carries out its effects; an effect that cannot be carried out comes back to
+    /// the core as the input it stands for (a scan order no worker took is a failed scan).
+    fn handle(&mut self, input: Input) {
+        let mut inputs = VecDeque::from([input]);
+        while let Some(input) = inputs.pop_front() {
+            for effect in self.core.handle(input) {
+                if let Some(back) = self.effect(effect) {
+                    inputs.push_back(back);
+                }
+            }
+        }
+    }
+
+    fn effect(&mut self, effect: Effect) -> Option<Input> {
+        match effect {
+            Effect::Reply { id, reply } => {
+                if let Some(sender) = self.replies.remove(&id) {
+                    let _ = sender.send(reply);
+                }
+            }
+            Effect::Publish(event) => {
+                let _ = self.events.send(event);
+            }
+            Effect::Prepare {
+                id,
+                kind,
+                part,
+                serial,
+            } => {
+                let config = self.config.clone();
+                self.blocking(move || {
+                    let result = prepare(&config, kind, &part, serial).map(Box::new);
+                    DaemonMsg::Prepared { id, result }
+                }, move |panic| DaemonMsg::Prepared {
+                    id,
+                    result: Err(super::job::JobError(format!(
+                        "setting up the job failed inside the station ({panic}); this is a bug: report it with the daemon's log"
+                    ))),
+                });
+            }
+            Effect::StartPipeline => self.start_pipeline(),
+            Effect::StopPipeline => self.pipeline = None,
+            Effect::Scan { machine, motion } => {
+                let key = motion.key;
+                let Some(pipeline) = self.pipeline.clone() else {
+                    return Some(station_fault(
+                        machine,
+                        key,
+                        "the job has no analysis running",
+                    ));
+                };
+                let given = self.workers.get(&machine).is_some_and(|worker| {
+                    worker
+                        .orders
+                        .try_send(Order::Scan { motion, pipeline })
+                        .is_ok()
+                });
+                if !given {
+                    return Some(station_fault(
+                        machine,
+                        key,
+                        "its worker does not take orders",
+                    ));
+                }
+            }
+            Effect::Abort { machine } => {
+                if let Some(worker) = self.workers.get(&machine).cloned() {
+                    tokio::spawn(async move { worker.abort().await });
+                }
+            }
+            Effect::Clear { machine, escape } => {
+                let (reply, answer) = oneshot::channel();
+                let given = self.workers.get(&machine).is_some_and(|worker| {
+                    worker
+                        .orders
+                        .try_send(Order::Clear { escape, reply })
+                        .is_ok()
+                });
+                if !given {
+                    return Some(Input::Cleared {
+                        result: Err(worker_gone(&machine)),
+                        machine,
+                    });
+                }
+                let to_self = self.to_self.clone();
+                tokio::spawn(async move {
+                    let result = answer.await.unwrap_or_else(|_| Err(worker_gone(&machine)));
+                    let _ = to_self.send(DaemonMsg::Cleared { machine, result }).await;
+                });
+            }
+            Effect::SaveRecord { dir, record } => {
+                if self.records.send((dir, record)).is_err() {
+                    tracing::error!("the job records' thread stopped; a job's state was not saved");
+                }
+            }
+            Effect::Finish => self.finish(),
+            Effect::ReadReport { id, serial } => {
+                if let Some(reply) = self.replies.remove(&id) {
+                    let config = self.config.clone();
+                    tokio::spawn(async move {
+                        let answer = tokio::task::spawn_blocking(move || report(&config, &serial))
+                            .await
+                            .unwrap_or_else(|panic| Reply::Error {
+                                message: format!("reading the report failed inside the station ({panic}); this is a bug"),
+                            });
+                        let _ = reply.send(answer);
+                    });
+                }
+            }
+        }
+        None
+    }
+
+    /// Runs `work` on a blocking thread and sends its message back; a panic there becomes `on_panic`'s message,
+    /// so a job never waits for an answer that cannot come.
+    fn blocking(
+        &self,
+        work: impl FnOnce() -> DaemonMsg + Send + 'static,
+        on_panic: impl FnOnce(String) -> DaemonMsg + Send + 'static,
+    ) {
+        let to_self = self.to_self.clone();
+        tokio::spawn(async move {
+            let message = tokio::task::spawn_blocking(work)
+                .await
+                .unwrap_or_else(|panic| on_panic(panic.to_string()));
+            let _ = to_self.send(message).await;
+        });
     }
 
     /// A fresh pipeline for the job (at its start, and when it resumes: a stopped job's scans were cut).
     fn start_pipeline(&mut self) {
-        let Some(job) = self.job.as_mut() else {
+        let Some(job) = self.core.job() else {
             return;
         };
         let (points, inbox) = mpsc::channel(QUEUE_POINTS);
@@ -197,164 +252,28 @@ impl Daemon {
             daemon: self.to_self.clone(),
         };
         tokio::spawn(pipeline.run(inbox));
-        job.pipeline = Some(points);
+        self.pipeline = Some(points);
     }
 
-    /// Gives every idle machine the remaining scan nearest to it.
-    fn dispatch(&mut self) {
-        let Some(job) = self.job.as_mut() else {
+    /// Fits the reference or writes the report off the decision task, from the scans on disk.
+    fn finish(&self) {
+        let Some(job) = self.core.job() else {
             return;
         };
-        if job.phase != Phase::Scanning {
-            return;
-        }
-        let Some(pipeline) = job.pipeline.clone() else {
-            return;
-        };
-        for slot in &mut self.slots {
-            if slot.state != SlotState::Idle || job.remaining.is_empty() {
-                continue;
-            }
-            let from = slot.at.unwrap_or_else(|| Point3::new(0.0, 0.0, 0.0));
-            let Some(index) = job
-                .plan
-                .nearest(&job.remaining, from, |key| job.scan_start(key))
-            else {
-                continue;
-            };
-            let key = job.remaining.remove(index);
-            let order = job.order(key, pipeline.clone());
-            if slot.handle.orders.try_send(Order::Scan(order)).is_err() {
-                job.remaining.insert(index, key);
-                continue;
-            }
-            slot.state = SlotState::Scanning(key);
-            slot.at = Some(job.scan_start(key));
-            self.events
-                .send(Event::ScanStarted {
-                    job: job.info.id.clone(),
-                    machine: slot.handle.name.clone(),
-                    scan: scan_ref(&job.plan, key),
-                    at_unix_ms: super::clock::unix_ms(),
-                })
-                .ok();
-            tracing::info!(job = %job.info.id, machine = %slot.handle.name, scan = %job.plan.describe(key), "scan started");
-        }
-    }
-
-    fn slot(&mut self, machine: &str) -> Option<&mut Slot> {
-        self.slots.iter_mut().find(|s| s.handle.name == machine)
-    }
-
-    fn scan_ended(&mut self, machine: &str, key: ProfileKey, result: Result<(), WorkerError>) {
-        let failed = result.as_ref().err().map(|e| e.message.clone());
-        if let Some(slot) = self.slot(machine) {
-            slot.state = match &failed {
-                None => SlotState::Idle,
-                Some(message) => SlotState::Faulted(message.clone()),
-            };
-        }
-        let Some(job) = self.job.as_mut() else {
-            return;
-        };
-        let Some(message) = failed else {
-            return;
-        };
-        if !job.stored.contains(&key) && !job.remaining.contains(&key) {
-            job.remaining.push(key);
-        }
-        if job.phase == Phase::Scanning {
-            let scan = scan_ref(&job.plan, key);
-            tracing::error!(job = %job.info.id, machine, scan = %job.plan.describe(key), error = %message, "job stopped");
-            let next_step = "remove the cause, then run `zeroset clear`: the job continues from its last complete profile".to_string();
-            job.phase = Phase::Stopped {
-                machine: Some(machine.to_string()),
-                scan: Some(scan.clone()),
-                reason: format!(
-                    "{} of part {}: {message}",
-                    job.plan.describe(key),
-                    job.info.part
-                ),
-                next_step: next_step.clone(),
-            };
-            let event = Event::JobStopped {
-                job: job.info.id.clone(),
-                machine: Some(machine.to_string()),
-                scan: Some(scan),
-                reason: message,
-                next_step,
-            };
-            self.publish(event);
-        }
-        self.abort_done_if_idle();
-    }
-
-    fn stored(&mut self, job_id: &str, key: ProfileKey, result: Result<(), String>) {
-        let Some(job) = self.job.as_mut().filter(|j| j.info.id == job_id) else {
-            return;
-        };
-        match result {
-            Ok(()) => {
-                job.stored.insert(key);
-            }
-            Err(error) => {
-                if !job.remaining.contains(&key) {
-                    job.remaining.push(key);
-                }
-                if job.phase == Phase::Scanning {
-                    let next_step =
-                        "free space or fix the data folder's permissions, then run `zeroset clear`"
-                            .to_string();
-                    let reason = format!(
-                        "{}: its points could not be stored: {error}",
-                        job.plan.describe(key)
-                    );
-                    job.phase = Phase::Stopped {
-                        machine: None,
-                        scan: Some(scan_ref(&job.plan, key)),
-                        reason: reason.clone(),
-                        next_step: next_step.clone(),
-                    };
-                    let event = Event::JobStopped {
-                        job: job_id.to_string(),
-                        machine: None,
-                        scan: Some(scan_ref(&job.plan, key)),
-                        reason,
-                        next_step,
-                    };
-                    self.publish(event);
-                }
-            }
-        }
-    }
-
-    /// Starts the fit or the report once every profile is on disk and no machine is still scanning.
-    fn finish_if_complete(&mut self) {
-        let busy = self
-            .slots
-            .iter()
-            .any(|s| matches!(s.state, SlotState::Scanning(_)));
-        let Some(job) = self.job.as_mut() else {
-            return;
-        };
-        if job.phase != Phase::Scanning || busy || job.stored.len() < job.total {
-            return;
-        }
-        job.phase = Phase::Finishing;
-        job.pipeline = None;
         let plan = job.plan.clone();
         let dir = job.dir.clone();
         let record = job.record.clone();
         let id = job.info.id.clone();
-        let to_self = self.to_self.clone();
         let config = self.config.clone();
         let reference = job.reference.clone();
         let gauges = job.gauges.clone();
         let tolerance = job.tolerance();
-        tokio::task::spawn_blocking(move || {
+        let kind = job.info.kind;
+        let panic_id = id.clone();
+        self.blocking(move || {
             let path = reference_path(&config, plan.part());
-            let result = match (reference, gauges) {
-                (Some(reference), Some(gauges)) => finish::write_inspection(&ReportInputs {
+            let result = match (kind, reference, gauges) {
+                (JobKind::Inspect, Some(reference), Some(gauges)) => finish::write_inspection(&ReportInputs {
                     plan: &plan,
                     dir: &dir,
                     record: &record,
@@ -367,288 +286,50 @@ impl Daemon {
                 }),
                 _ => finish::fit_reference(&plan, &dir, &path),
             };
-            let _ = to_self.blocking_send(DaemonMsg::Finished { job: id, result });
+            DaemonMsg::Finished { job: id, result }
+        }, move |panic| DaemonMsg::Finished {
+            job: panic_id,
+            result: Err::<Outcome, _>(format!(
+                "finishing the job failed inside the station ({panic}); its scans are on disk; this is a bug: report it with the daemon's log"
+            )),
         });
     }
+}
 
-    fn finished(&mut self, job_id: &str, result: Result<Outcome, String>) {
-        let Some(job) = self.job.as_mut().filter(|j| j.info.id == job_id) else {
-            return;
-        };
-        let event = match result {
-            Ok(Outcome::Taught { path, profiles }) => {
-                job.record.state = JobState::Finished;
-                job.phase = Phase::Over("finished".into());
-                Event::ReferenceSaved {
-                    job: job_id.to_string(),
-                    part: job.info.part.clone(),
-                    path,
-                    profiles,
-                }
-            }
-            Ok(Outcome::Inspected {
-                dir,
-                instances,
-                verdict,
-            }) => {
-                job.record.state = JobState::Finished;
-                job.record.report = Some(dir.clone());
-                job.phase = Phase::Over("finished".into());
-                Event::JobFinished {
-                    job: job_id.to_string(),
-                    report: Some(dir),
-                    instances,
-                    verdict: Some(verdict),
-                }
-            }
-            Err(error) => {
-                job.record.state = JobState::Failed {
-                    error: error.clone(),
-                };
-                job.phase = Phase::Over(format!("failed: {error}"));
-                Event::JobFailed {
-                    job: job_id.to_string(),
-                    error,
-                }
-            }
-        };
-        if let Err(error) = job.dir.save_record(&job.record) {
-            tracing::error!(job = job_id, %error, "cannot record the job's end");
+/// The newest job a previous daemon left open, if it can be reopened.
+fn reopen(config: &StationConfig) -> anyhow::Result<Option<Job>> {
+    let mut open = open_jobs(&config.folders.data)?;
+    let Some((dir, record)) = open.pop() else {
+        return Ok(None);
+    };
+    let id = record.id.clone();
+    match Job::reopen(config, dir, record) {
+        Ok(job) => {
+            tracing::info!(job = %id, done = job.stored.len(), total = job.total, "reopened a job left open");
+            Ok(Some(job))
         }
-        tracing::info!(job = job_id, ?event, "job over");
-        self.publish(event);
-    }
-
-    fn abort(&mut self) -> Reply {
-        let Some(job) = self.job.as_mut().filter(|j| !j.is_over()) else {
-            return Reply::Error {
-                message: "no job to abort".into(),
-            };
-        };
-        if job.phase == Phase::Finishing {
-            return Reply::Error {
-                message: format!(
-                    "job {} has every profile on disk and is being finished; it cannot be aborted now",
-                    job.info.id
-                ),
-            };
-        }
-        job.phase = Phase::Aborting;
-        let id = job.info.id.clone();
-        for slot in &self.slots {
-            if matches!(slot.state, SlotState::Scanning(_)) {
-                let handle = slot.handle.clone();
-                tokio::spawn(async move { handle.abort().await });
-            }
-        }
-        self.abort_done_if_idle();
-        Reply::Done {
-            message: format!(
-                "job {id}: motion stopped; the job is aborted (its scans so far stay on disk)"
-            ),
-        }
-    }
-
-    /// Once an aborted job's machines have stopped: the job is over and the machines are cleared (an operator's
-    /// abort is no fault to remove).
-    fn abort_done_if_idle(&mut self) {
-        if self
-            .slots
-            .iter()
-            .any(|s| matches!(s.state, SlotState::Scanning(_)))
-        {
-            return;
-        }
-        let Some(job) = self.job.as_mut().filter(|j| j.phase == Phase::Aborting) else {
-            return;
-        };
-        job.record.state = JobState::Aborted;
-        job.phase = Phase::Over("aborted".into());
-        if let Err(error) = job.dir.save_record(&job.record) {
-            tracing::error!(job = %job.info.id, %error, "cannot record the abort");
-        }
-        let id = job.info.id.clone();
-        self.publish(Event::JobAborted { job: id });
-        self.clear_machines();
-    }
-
-    fn clear(&mut self, reply: oneshot::Sender<Reply>) {
-        if self.clearing.is_some() || self.slots.iter().any(|s| s.state == SlotState::Clearing) {
-            let _ = reply.send(Reply::Error {
-                message: "a clear is already in progress".into(),
-            });
-            return;
-        }
-        if let Some(job) = self.job.as_ref() {
-            if matches!(
-                job.phase,
-                Phase::Scanning | Phase::Finishing | Phase::Aborting
-            ) {
-                let _ = reply.send(Reply::Error {
-                    message: format!(
-                        "job {} is {}: nothing to clear",
-                        job.info.id,
-                        phase_name(&job.phase)
-                    ),
-                });
-                return;
-            }
-        }
-        self.clearing = Some(reply);
-        self.clear_machines();
-        self.resume_if_clear();
-    }
-
-    /// Asks every machine that is not scanning to clear its errors and leave the part, with the path of a scan a
-    /// killed daemon cut short when the machine has none of its own.
-    fn clear_machines(&mut self) {
-        let cut_paths: Vec<(String, super::KnownPath, f64)> = self
-            .job
-            .as_ref()
-            .filter(|j| !j.is_over())
-            .map(|job| {
-                job.cut_scans()
-                    .into_iter()
-                    .filter_map(|key| job.cut_scan_path(key))
-                    .map(|(machine, path)| (machine, path, job.margin_mm()))
-                    .collect()
-            })
-            .unwrap_or_default();
-        for slot in &mut self.slots {
-            if matches!(slot.state, SlotState::Scanning(_) | SlotState::Clearing) {
-                continue;
-            }
-            let path = cut_paths
-                .iter()
-                .find(|(machine, _, _)| *machine == slot.handle.name)
-                .map(|(_, path, margin)| (path.clone(), *margin));
-            let (reply, answer) = oneshot::channel();
-            if slot
-                .handle
-                .orders
-                .try_send(Order::Clear { path, reply })
-                .is_err()
-            {
-                continue;
-            }
-            slot.state = SlotState::Clearing;
-            let machine = slot.handle.name.clone();
-            let to_self = self.to_self.clone();
-            tokio::spawn(async move {
-                let result = answer
-                    .await
-                    .unwrap_or_else(|_| Err(format!("machine {machine}: its worker stopped")));
-                let _ = to_self.send(DaemonMsg::Cleared { machine, result }).await;
-            });
-        }
-    }
-
-    fn cleared(&mut self, machine: &str, result: Result<(), String>) {
-        if let Some(slot) = self.slot(machine) {
-            slot.state = match &result {
-                Ok(()) => SlotState::Idle,
-                Err(message) => SlotState::Faulted(message.clone()),
-            };
-        }
-        if let Err(message) = &result {
-            tracing::error!(machine, error = %message, "clear failed");
-        }
-        self.resume_if_clear();
-    }
-
-    /// When no machine is clearing any more: answer the operator, and resume a stopped job if all went well.
-    fn resume_if_clear(&mut self) {
-        if self.slots.iter().any(|s| s.state == SlotState::Clearing) {
-            return;
-        }
-        let faults: Vec<String> = self
-            .slots
-            .iter()
-            .filter_map(|s| match &s.state {
-                SlotState::Faulted(message) => Some(message.clone()),
-                _ => None,
-            })
-            .collect();
-        let Some(reply) = self.clearing.take() else {
-            return;
-        };
-        if !faults.is_empty() {
-            let _ = reply.send(Reply::Error {
-                message: format!("not cleared: {}", faults.join("; ")),
-            });
-            return;
-        }
-        let resumed = match self.job.as_mut() {
-            Some(job) if matches!(job.phase, Phase::Stopped { .. }) => {
-                job.phase = Phase::Scanning;
-                Some((job.info.clone(), job.done_refs()))
-            }
-            _ => None,
-        };
-        let message = match resumed {
-            Some((info, done)) => {
-                self.start_pipeline();
-                self.publish(Event::JobStarted {
-                    job: info.clone(),
-                    done,
-                });
-                self.publish(Event::JobResumed {
-                    job: info.id.clone(),
-                });
-                format!(
-                    "machines clear; job {} continues from its last complete profile",
-                    info.id
-                )
-            }
-            None => "machines clear".to_string(),
-        };
-        let _ = reply.send(Reply::Done { message });
-    }
-
-    fn status(&self) -> StationStatus {
-        let machines = self
-            .slots
-            .iter()
-            .map(|slot| MachineStatus {
-                name: slot.handle.name.clone(),
-                state: match (&slot.state, &self.job) {
-                    (SlotState::Idle, _) => "idle".into(),
-                    (SlotState::Scanning(key), Some(job)) => {
-                        format!("scanning {}", job.plan.describe(*key))
-                    }
-                    (SlotState::Scanning(_), None) => "scanning".into(),
-                    (SlotState::Faulted(message), _) => format!("stopped: {message}"),
-                    (SlotState::Clearing, _) => "clearing".into(),
-                },
-            })
-            .collect();
-        let job = self.job.as_ref().map(|job| JobStatus {
-            job: job.info.clone(),
-            state: phase_name(&job.phase),
-            stopped: match &job.phase {
-                Phase::Stopped {
-                    reason, next_step, ..
-                } => Some(format!("{reason}; {next_step}")),
-                _ => None,
-            },
-            profiles_done: job.stored.len(),
-            profiles_total: job.total,
-        });
-        StationStatus {
-            station: self.config.name.clone(),
-            machines,
-            job,
+        Err(error) => {
+            tracing::error!(job = %id, %error, "cannot reopen a job left open");
+            Ok(None)
         }
     }
 }
 
-fn phase_name(phase: &Phase) -> String {
-    match phase {
-        Phase::Scanning => "running".into(),
-        Phase::Stopped { .. } => "stopped".into(),
-        Phase::Aborting => "aborting".into(),
-        Phase::Finishing => "finishing".into(),
-        Phase::Over(how) => how.clone(),
+fn worker_gone(machine: &str) -> WorkerError {
+    WorkerError {
+        kind: FaultKind::Station,
+        message: format!("machine {machine}: its worker stopped; restart the daemon"),
+    }
+}
+
+fn station_fault(machine: String, key: crate::plan::ProfileKey, why: &str) -> Input {
+    Input::ScanEnded {
+        result: Err(WorkerError {
+            kind: FaultKind::Station,
+            message: format!("machine {machine}: the scan was not started: {why}"),
+        }),
+        machine,
+        key,
     }
 }
 

@@ -6,8 +6,15 @@
 //! entry point, reached by a vertical move down from the clearance height. So the way out follows that path back
 //! to the entry, held off the surface by a margin, and leaves vertically the way it came in.
 
+use std::sync::Arc;
+
 use nalgebra::{Point3, Vector3};
 use zeroset_drivers::machine::CurveScan;
+
+use crate::config::Safety;
+use crate::geometry::sweep::closest::closest_between_segments;
+use crate::geometry::sweep::mesh::MeshPart;
+use crate::geometry::sweep::part::PartDistance;
 
 /// A known stretch of surface along which the ball travelled, and where its scan entered.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +39,24 @@ pub enum EscapeError {
     },
     #[error("the probe is at ({:.3}, {:.3}, {:.3}) mm, below the clearance height, and no scan path is known around it", .0.x, .0.y, .0.z)]
     Unknown(Point3<f64>),
+    /// A leg of the planned way out comes too close to what is known of the part.
+    #[error("the way out from ({:.3}, {:.3}, {:.3}) mm is not clear: its leg {leg} to ({:.3}, {:.3}, {:.3}) mm brings the ball to {clearance_mm:.3} mm of {against}", .position.x, .position.y, .position.z, .to.x, .to.y, .to.z)]
+    NotClear {
+        position: Point3<f64>,
+        leg: usize,
+        to: Point3<f64>,
+        clearance_mm: f64,
+        against: &'static str,
+    },
+}
+
+/// What a way out after a stop is planned from, besides the path the worker itself was on, and checked against.
+#[derive(Clone, Default)]
+pub struct EscapeModel {
+    /// The path of a scan a killed daemon cut short, with its margin (mm), for a worker that knows none.
+    pub cut: Option<(KnownPath, f64)>,
+    /// The taught part on the machine, every instance (none when teaching: then only the known path counts).
+    pub part: Option<Arc<MeshPart>>,
 }
 
 /// Waypoints between consecutive points of the way out are at most this far apart, mm, and closer where the
@@ -63,15 +88,57 @@ impl KnownPath {
         }
     }
 
+    /// Refuses a path no move may be planned from: empty, an entry beyond its points, a point that is not finite
+    /// or a normal that is not a unit vector (a zero normal would send NaN targets).
+    pub fn validate(&self) -> Result<(), String> {
+        if self.surface.is_empty() || self.surface.len() != self.normals.len() {
+            return Err(format!(
+                "the known path has {} points and {} normals",
+                self.surface.len(),
+                self.normals.len()
+            ));
+        }
+        if self.entry >= self.surface.len() {
+            return Err(format!(
+                "the entry {} is beyond the path's {} points",
+                self.entry,
+                self.surface.len()
+            ));
+        }
+        let bad = self.surface.iter().zip(&self.normals).position(|(p, n)| {
+            !(p.coords.iter().all(|c| c.is_finite()) && (n.norm() - 1.0).abs() < 1e-6)
+        });
+        match bad {
+            Some(i) => Err(format!(
+                "point {i} of the known path, ({:.3}, {:.3}, {:.3}) mm with normal ({}, {}, {}), is not a finite \
+                 point with a unit normal; teach the part again",
+                self.surface[i].x,
+                self.surface[i].y,
+                self.surface[i].z,
+                self.normals[i].x,
+                self.normals[i].y,
+                self.normals[i].z
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// Where the ball enters and leaves this path: above the entry point by the ball radius and `margin`.
     pub fn entry_offset(&self, ball_radius: f64, margin: f64) -> Point3<f64> {
         self.surface[self.entry] + self.normals[self.entry] * (ball_radius + margin)
     }
 }
 
-/// The moves that take the ball from `position` to the clearance height: along the known path, `margin` mm off
-/// the surface beyond the ball, back to the entry, then straight up. Empty when the ball is already at or above
-/// the clearance height.
+/// The moves that take the ball from `position` to the clearance height: off the known surface along its normal
+/// to `margin` mm beyond the ball, along the path at that offset back to the entry, then straight up. Empty when
+/// the ball is already at or above the clearance height.
+///
+/// The first leg leaves from where the ball is, not from a recorded point: straight away from the nearest point of
+/// the known surface (its normal there), which only increases the clearance from a surface that is convex there or
+/// concave with a radius larger than the ball and the margin. A ball that stopped past the end of an open path (a
+/// teach scan's last points not yet reported) lifts across its own unreported travel: perpendicular to the chord
+/// from the last reported centre, on the outside; such a stretch no longer than the margin's allowance is taken
+/// as locally convex, a longer one is refused.
 pub fn way_out(
     position: Point3<f64>,
     path: Option<&KnownPath>,
@@ -85,21 +152,44 @@ pub fn way_out(
     let Some(path) = path.filter(|p| !p.surface.is_empty()) else {
         return Err(EscapeError::Unknown(position));
     };
-    let centre = |i: usize| path.surface[i] + path.normals[i] * ball_radius;
-    let (nearest, distance) = (0..path.surface.len())
-        .map(|i| (i, (centre(i) - position).norm()))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .expect("a non-empty path");
-    if distance > margin + ON_PATH_TOLERANCE_MM {
+    let foot = nearest_on_path(path, &position);
+    if foot.distance > ball_radius + margin + ON_PATH_TOLERANCE_MM {
         return Err(EscapeError::OffPath {
             position,
-            off_path_mm: distance,
+            off_path_mm: foot.distance - ball_radius,
         });
     }
+    let normal = foot.normal;
+    let (lifted, join) = if foot.past_end {
+        let last = path.surface.len() - 1;
+        let centre = path.surface[last] + path.normals[last] * ball_radius;
+        let chord = position - centre;
+        // Outward and perpendicular to the chord, in the plane of the chord and the last normal.
+        let out = (normal - chord * (normal.dot(&chord) / chord.norm_squared().max(1e-300)))
+            .try_normalize(1e-9)
+            .unwrap_or(normal);
+        (position + out * margin, last)
+    } else {
+        let away = (position - foot.point)
+            .try_normalize(1e-9)
+            .filter(|u| u.dot(&normal) > 0.0)
+            .unwrap_or(normal);
+        if (position - foot.point).dot(&normal) < 0.0 {
+            // The ball centre lies on the inner side of the known surface: that surface is not where the part
+            // is, and no move away from it can be trusted.
+            return Err(EscapeError::OffPath {
+                position,
+                off_path_mm: -foot.distance,
+            });
+        }
+        let lift = (ball_radius + margin - foot.distance).max(0.0);
+        (position + away * lift, foot.toward_entry)
+    };
     let offset = |i: usize| path.surface[i] + path.normals[i] * (ball_radius + margin);
-    let mut moves = vec![offset(nearest)];
-    let mut last = nearest;
-    for i in walk(nearest, path.entry, path.surface.len(), path.closed) {
+    let mut moves = vec![lifted];
+    let mut last = join;
+    moves.push(offset(join));
+    for i in walk(join, path.entry, path.surface.len(), path.closed) {
         let far = (path.surface[i] - path.surface[last]).norm() >= WAYPOINT_SPACING_MM;
         let turned = path.normals[i].angle(&path.normals[last]) >= WAYPOINT_TURN_RAD;
         if far || turned || i == path.entry {
@@ -109,7 +199,162 @@ pub fn way_out(
     }
     let exit = offset(path.entry);
     moves.push(Point3::new(exit.x, exit.y, clearance_z.max(exit.z)));
+    moves.dedup_by(|b, a| (*b - *a).norm() < 1e-9);
     Ok(moves)
+}
+
+/// The way out from `position` (`way_out`), each leg checked before anything moves, for the ball (the shank is
+/// judged as for the contact scan it leaves: a vertical stylus under a blade has its shank through the blade, which
+/// a real station avoids with a probe head that turns the stylus): once off the surface the ball never comes nearer
+/// the known surface, nor the taught part model, than the move margin; on the first leg, which may start in
+/// contact, it never comes nearer than it started. A way out that fails either is refused: nothing is moved.
+pub fn plan_escape(
+    position: Point3<f64>,
+    path: Option<(&KnownPath, f64)>,
+    ball_radius: f64,
+    safety: &Safety,
+    model: &EscapeModel,
+) -> Result<Vec<Point3<f64>>, EscapeError> {
+    let (known, margin) = match path {
+        Some((path, margin)) => (Some(path), margin),
+        None => (None, 0.0),
+    };
+    let moves = way_out(position, known, ball_radius, margin, safety.clearance_z_mm)?;
+    let wanted = safety.move_margin_mm;
+    let mut from = position;
+    for (leg, &to) in moves.iter().enumerate() {
+        let mut against: Vec<(&'static str, f64, f64)> = Vec::new();
+        if let Some(path) = known {
+            let start = surface_distance(path, &from, &from) - ball_radius;
+            let least = surface_distance(path, &from, &to) - ball_radius;
+            against.push(("the known surface", start, least));
+        }
+        if let Some(part) = model.part.as_deref() {
+            let start = part.distance(&from) - ball_radius;
+            let least = ball_clearance(part, &from, &to, ball_radius, wanted);
+            // The mesh lies within its chord tolerance of the model: a lift-off may seem to dip by as much.
+            against.push((
+                "the taught part model",
+                start + part.chord_tolerance_mm(),
+                least,
+            ));
+        }
+        for (what, start, least) in against {
+            let needed = if leg == 0 {
+                start.min(wanted) - 1e-9
+            } else {
+                wanted
+            };
+            if least < needed {
+                return Err(EscapeError::NotClear {
+                    position,
+                    leg,
+                    to,
+                    clearance_mm: least,
+                    against: what,
+                });
+            }
+        }
+        from = to;
+    }
+    Ok(moves)
+}
+
+/// The least clearance (mm) of a ball moved straight from `a` to `b` against `part`, by conservative advancement
+/// (the distance is 1-Lipschitz along the centre's path, so a step no longer than the gap cannot pass through the
+/// surface); once below `margin` it goes on towards contact to find the least.
+fn ball_clearance(
+    part: &MeshPart,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    radius: f64,
+    margin: f64,
+) -> f64 {
+    const RESOLUTION_MM: f64 = 1e-4;
+    let length = (b - a).norm();
+    let mut t = 0.0;
+    let mut least = f64::INFINITY;
+    loop {
+        let gap = part.distance(&(a + (b - a) * t)) - radius;
+        least = least.min(gap);
+        if gap <= 0.0 || t >= 1.0 || length == 0.0 {
+            return least;
+        }
+        let target = if least >= margin { margin } else { 0.0 };
+        t = (t + (gap - target).max(RESOLUTION_MM) / length).min(1.0);
+    }
+}
+
+/// The least distance from the segment [a, b] of ball centres to the known surface's polyline.
+fn surface_distance(path: &KnownPath, a: &Point3<f64>, b: &Point3<f64>) -> f64 {
+    let n = path.surface.len();
+    let segments = if path.closed || n == 1 { n } else { n - 1 };
+    (0..segments)
+        .map(|i| {
+            let (s, t) =
+                closest_between_segments(a, b, &path.surface[i], &path.surface[(i + 1) % n]);
+            (s - t).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The point of the known surface nearest a ball centre.
+struct Foot {
+    point: Point3<f64>,
+    /// The surface normal there, interpolated between the path's normals.
+    normal: Vector3<f64>,
+    distance: f64,
+    /// Of the two path points around the foot, the one on the way to the entry.
+    toward_entry: usize,
+    /// The foot is the end of an open path and the centre lies beyond it.
+    past_end: bool,
+}
+
+fn nearest_on_path(path: &KnownPath, centre: &Point3<f64>) -> Foot {
+    let n = path.surface.len();
+    let segments = if path.closed { n } else { n.saturating_sub(1) };
+    let mut best = Foot {
+        point: path.surface[0],
+        normal: path.normals[0],
+        distance: (centre - path.surface[0]).norm(),
+        toward_entry: 0,
+        past_end: false,
+    };
+    for i in 0..segments {
+        let j = (i + 1) % n;
+        let (a, b) = (path.surface[i], path.surface[j]);
+        let ab = b - a;
+        let t = ((centre - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+        let point = a + ab * t;
+        let distance = (centre - point).norm();
+        if distance < best.distance {
+            let normal = (path.normals[i] * (1.0 - t) + path.normals[j] * t)
+                .try_normalize(1e-9)
+                .unwrap_or(path.normals[i]);
+            // The way out joins the path at the nearer of the segment's ends.
+            let toward_entry = if t <= 0.5 { i } else { j };
+            best = Foot {
+                point,
+                normal,
+                distance,
+                toward_entry,
+                past_end: false,
+            };
+        }
+    }
+    if !path.closed {
+        let last = n - 1;
+        let beyond = n > 1 && {
+            let along = path.surface[last] - path.surface[last - 1];
+            (best.point - path.surface[last]).norm() < 1e-12
+                && (centre - path.surface[last]).dot(&along) > 0.0
+        };
+        if beyond {
+            best.past_end = true;
+            best.toward_entry = last;
+        }
+    }
+    best
 }
 
 /// The indices from `from` (exclusive) to `to` (inclusive): the shorter way round a closed path, else straight.

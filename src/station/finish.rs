@@ -90,8 +90,8 @@ fn reference_fits(reference: &Reference, profiles: &[MasterProfile]) -> Vec<Prof
     let fit = |master: &MasterProfile, rms_mm: Option<f64>, max_mm: Option<f64>| ProfileFit {
         profile: master.name.clone(),
         points: master.points.len(),
-        rms_mm: rms_mm.unwrap_or(f64::NAN),
-        max_mm: max_mm.unwrap_or(f64::NAN),
+        rms_mm,
+        max_mm,
     };
     match &reference.model.model {
         ReferenceModel::Stack { profiles: fitted } => fitted

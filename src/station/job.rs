@@ -1,7 +1,7 @@
 //! A job in the daemon: its plan, what is left to scan, what is done, and how its scans are set up. Built either
 //! fresh from an operator's request or from a job folder left open by a fault or a killed daemon.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -10,41 +10,19 @@ use nalgebra::{Point3, Vector3};
 use super::clearance;
 use super::escape::KnownPath;
 use super::journal::{file_stem, JobDir, JobRecord, JobState};
-use super::pipeline::{scan_ref, PipelineMsg};
-use super::worker::{Scan, ScanOrder};
+use super::motion::{job_motions, ScanMotion};
+use super::pipeline::scan_ref;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::Reference;
 use crate::analysis::stats::Tolerance;
 use crate::analysis::surface_point;
-use crate::api::{JobInfo, JobKind, ScanRef};
+use crate::api::{JobInfo, JobKind, JobPhase, ScanRef};
 use crate::config::{PartConfig, StationConfig};
+use crate::geometry::sweep::mesh::MeshPart;
 use crate::plan::{Plan, ProfileKey};
 
-/// Teaching starts from a point of the drawing, not of the part: the probe enters this far above it, mm.
-const TEACH_MARGIN_MM: f64 = 5.0;
-/// Inspecting follows the taught curve; the real surface lies within the expected deviation of it, so the probe
-/// keeps this much more off it when entering and leaving, mm.
-const INSPECT_EXTRA_MARGIN_MM: f64 = 2.0;
-
-/// Where a job is.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Phase {
-    Scanning,
-    /// Stopped by a fault; waits for `zeroset clear`.
-    Stopped {
-        machine: Option<String>,
-        scan: Option<ScanRef>,
-        reason: String,
-        next_step: String,
-    },
-    /// The operator aborted: waiting for the machines to stop and clear.
-    Aborting,
-    /// Every profile is on disk: fitting the reference or writing the report.
-    Finishing,
-    /// Finished, aborted or failed: kept for `zeroset status`.
-    Over(String),
-}
-
+/// A job: what it scans and how, and how far it has got. Built off the daemon's decision task (loading and
+/// checking take most of a second), then owned by it.
 pub struct Job {
     pub info: JobInfo,
     pub record: JobRecord,
@@ -52,11 +30,17 @@ pub struct Job {
     pub plan: Arc<Plan>,
     pub reference: Option<Arc<Reference>>,
     pub gauges: Option<Arc<Vec<ProfileGauge>>>,
+    /// Every scan's motion, built once: checked before the job starts and sent as it is.
+    pub motions: BTreeMap<ProfileKey, ScanMotion>,
+    /// The taught part on the machine, every instance: what a way out after a stop is checked against.
+    pub part_model: Option<Arc<MeshPart>>,
+    /// The scans a killed daemon cut short, read from their partial files when the job was reopened: the machine
+    /// that scanned each, the path its way out follows and its margin (mm).
+    pub cut_paths: Vec<(String, KnownPath, f64)>,
     pub remaining: Vec<ProfileKey>,
     pub stored: BTreeSet<ProfileKey>,
     pub total: usize,
-    pub phase: Phase,
-    pub pipeline: Option<tokio::sync::mpsc::Sender<PipelineMsg>>,
+    pub phase: JobPhase,
 }
 
 /// Why a job cannot start: said so that the operator knows what to do.
@@ -90,11 +74,78 @@ pub fn reference_path(config: &StationConfig, part: &str) -> PathBuf {
         .join(format!("{part}.json"))
 }
 
-/// The reference of a part, and a gauge per profile (sampling each profile's zero set: done once per job).
-pub fn load_reference(
+/// A new job of `kind` on `part`, its moves planned and (inspecting) checked against the taught part, its folder
+/// created. Blocking: it loads files and meshes the part.
+pub fn prepare(
+    config: &StationConfig,
+    kind: JobKind,
+    part: &str,
+    serial: Option<String>,
+) -> Result<Job, JobError> {
+    let plan = load_plan(config, part)?;
+    let reference = match kind {
+        JobKind::Teach => None,
+        JobKind::Inspect => Some(load_reference(config, &plan)?),
+    };
+    let (motions, part_model) = plan_moves(config, &plan, kind, reference.as_ref().map(|r| &*r.0))?;
+    Job::create(config, kind, plan, serial, reference, motions, part_model)
+}
+
+/// A job's planned motions by profile, and the taught part they were checked against.
+type PlannedMoves = (BTreeMap<ProfileKey, ScanMotion>, Option<Arc<MeshPart>>);
+
+/// A reference and a gauge per profile.
+type LoadedReference = (Arc<Reference>, Arc<Vec<ProfileGauge>>);
+
+/// Every scan's motion, and (inspecting) the taught part on the machine with every free move checked against it.
+fn plan_moves(
     config: &StationConfig,
     plan: &Plan,
-) -> Result<(Arc<Reference>, Arc<Vec<ProfileGauge>>), JobError> {
+    kind: JobKind,
+    reference: Option<&Reference>,
+) -> Result<PlannedMoves, JobError> {
+    let keys = job_scans(plan, kind);
+    let motions = job_motions(plan, reference, &keys, &config.safety).map_err(|e| {
+        JobError(format!(
+            "{e}; check the part file and [safety] of the station file"
+        ))
+    })?;
+    let part_model = match reference {
+        Some(reference) => {
+            let part = clearance::machine_part(plan, reference).map_err(JobError)?;
+            check_moves(config, plan, &motions, &part)?;
+            Some(Arc::new(part))
+        }
+        None => None,
+    };
+    let motions = motions.into_iter().map(|m| (m.key, m)).collect();
+    Ok((motions, part_model))
+}
+
+/// Refuses a plan whose descents, lift-offs or ways out would bring the stylus closer to the taught part than the
+/// station's move margin (`clearance`).
+fn check_moves(
+    config: &StationConfig,
+    plan: &Plan,
+    motions: &[ScanMotion],
+    part: &MeshPart,
+) -> Result<(), JobError> {
+    let stylus = clearance::station_stylus(config).map_err(JobError)?;
+    let moves = clearance::swept_moves(motions)
+        .map_err(JobError)?
+        .into_iter()
+        .filter(|m| m.kind != clearance::MoveKind::Scan)
+        .collect();
+    let margin = config.safety.move_margin_mm;
+    let checked = clearance::check_moves(&stylus, moves, part, margin);
+    match clearance::refusal(plan, &checked, margin) {
+        Some(message) => Err(JobError(message)),
+        None => Ok(()),
+    }
+}
+
+/// The reference of a part, and a gauge per profile (sampling each profile's zero set: done once per job).
+pub fn load_reference(config: &StationConfig, plan: &Plan) -> Result<LoadedReference, JobError> {
     let path = reference_path(config, plan.part());
     if !path.exists() {
         return Err(JobError(format!(
@@ -119,12 +170,14 @@ pub fn load_reference(
 
 impl Job {
     /// A new job, its folder created.
-    pub fn create(
+    fn create(
         config: &StationConfig,
         kind: JobKind,
         plan: Plan,
         serial: Option<String>,
-        reference: Option<(Arc<Reference>, Arc<Vec<ProfileGauge>>)>,
+        reference: Option<LoadedReference>,
+        motions: BTreeMap<ProfileKey, ScanMotion>,
+        part_model: Option<Arc<MeshPart>>,
     ) -> Result<Job, JobError> {
         let started = super::clock::now_rfc3339();
         let id = format!(
@@ -150,17 +203,25 @@ impl Job {
             dir,
             plan,
             reference,
+            (motions, part_model),
             BTreeSet::new(),
         ))
     }
 
-    /// A job left open on disk: its complete profiles stay done, the rest is scanned after `zeroset clear`.
+    /// A job left open on disk: its complete profiles stay done, the rest is scanned after `zeroset clear` by the
+    /// same motions, planned and checked again.
     pub fn reopen(config: &StationConfig, dir: JobDir, record: JobRecord) -> Result<Job, JobError> {
         let plan = load_plan(config, &record.part)?;
         let reference = match record.kind {
             JobKind::Teach => None,
             JobKind::Inspect => Some(load_reference(config, &plan)?),
         };
+        let moves = plan_moves(
+            config,
+            &plan,
+            record.kind,
+            reference.as_ref().map(|r| &*r.0),
+        )?;
         let completed = dir
             .completed()
             .map_err(|e| JobError(format!("cannot read {}: {e}", dir.path().display())))?;
@@ -170,8 +231,13 @@ impl Job {
             .copied()
             .filter(|key| completed.contains(&file_stem(&scan_ref(&plan, *key))))
             .collect();
-        let mut job = Job::from_parts(config, record, dir, plan, reference, stored);
-        job.phase = Phase::Stopped {
+        let mut job = Job::from_parts(config, record, dir, plan, reference, moves, stored);
+        job.cut_paths = job
+            .cut_scans()
+            .into_iter()
+            .filter_map(|key| job.cut_scan_path(key))
+            .collect();
+        job.phase = JobPhase::Stopped {
             machine: None,
             scan: None,
             reason: "the daemon stopped while this job was running".into(),
@@ -185,7 +251,8 @@ impl Job {
         record: JobRecord,
         dir: JobDir,
         plan: Plan,
-        reference: Option<(Arc<Reference>, Arc<Vec<ProfileGauge>>)>,
+        reference: Option<LoadedReference>,
+        (motions, part_model): PlannedMoves,
         stored: BTreeSet<ProfileKey>,
     ) -> Job {
         let keys = job_scans(&plan, record.kind);
@@ -217,11 +284,13 @@ impl Job {
             plan: Arc::new(plan),
             reference,
             gauges,
+            motions,
+            part_model,
+            cut_paths: Vec::new(),
             remaining,
             stored,
             total: keys.len(),
-            phase: Phase::Scanning,
-            pipeline: None,
+            phase: JobPhase::Running,
         }
     }
 
@@ -234,7 +303,7 @@ impl Job {
     }
 
     pub fn is_over(&self) -> bool {
-        matches!(self.phase, Phase::Over(_))
+        self.phase.is_over()
     }
 
     pub fn done_refs(&self) -> Vec<ScanRef> {
@@ -242,11 +311,6 @@ impl Job {
             .iter()
             .map(|k| scan_ref(&self.plan, *k))
             .collect()
-    }
-
-    /// How far the probe keeps off the known surface when entering and leaving a scan, mm.
-    pub fn margin_mm(&self) -> f64 {
-        scan_margin_mm(&self.plan, self.record.kind)
     }
 
     /// Where a profile's scan starts, machine coordinates: for choosing the next scan nearest a machine.
@@ -258,67 +322,27 @@ impl Job {
         self.plan.scan_start(key, nominals)
     }
 
-    /// The order that scans `key`, and the surface the station knows around it before scanning.
-    pub fn order(
-        &self,
-        key: ProfileKey,
-        pipeline: tokio::sync::mpsc::Sender<PipelineMsg>,
-    ) -> ScanOrder {
-        let (scan, path) = self.scan_and_path(key);
-        ScanOrder {
-            key,
-            scan,
-            path,
-            margin_mm: self.margin_mm(),
-            pipeline,
-        }
-    }
-
-    fn scan_and_path(&self, key: ProfileKey) -> (Scan, KnownPath) {
-        match &self.reference {
-            Some(reference) => {
-                let plan = self
-                    .plan
-                    .curve_scan(key, &reference.profiles[key.profile].nominals);
-                let path = KnownPath::of_curve_scan(&plan);
-                (Scan::Curve(plan), path)
-            }
-            None => {
-                let plan = self.plan.in_plane_scan(key);
-                let path = KnownPath {
-                    surface: vec![Point3::new(plan.start.x, plan.start.y, plan.start.z)],
-                    normals: vec![Vector3::new(
-                        plan.start_normal.x,
-                        plan.start_normal.y,
-                        plan.start_normal.z,
-                    )
-                    .normalize()],
-                    closed: false,
-                    entry: 0,
-                };
-                (Scan::InPlane(plan), path)
-            }
-        }
-    }
-
     /// The surface around a profile whose scan was cut by a killed daemon, from its partial file: the machine
     /// that scanned it and the path for its way out. `None` when no such file is there.
-    pub fn cut_scan_path(&self, key: ProfileKey) -> Option<(String, KnownPath)> {
+    fn cut_scan_path(&self, key: ProfileKey) -> Option<(String, KnownPath, f64)> {
         let (header, points) = self.dir.read_partial(&scan_ref(&self.plan, key)).ok()??;
-        let (_, mut path) = self.scan_and_path(key);
+        let motion = self.motions.get(&key)?;
+        let mut path = motion.path.clone();
         if self.reference.is_none() {
             // Along the reported normals, point by point: the way out needs a safe path near the surface, not
             // the compensated contacts, and a cut scan's last points have no look-ahead anyway.
             for raw in &points {
-                path.surface.push(surface_point(raw, header.ball_radius_mm));
-                path.normals.push(Vector3::from(raw.normal).normalize());
+                if let Some(normal) = Vector3::from(raw.normal).try_normalize(1e-9) {
+                    path.surface.push(surface_point(raw, header.ball_radius_mm));
+                    path.normals.push(normal);
+                }
             }
         }
-        Some((header.machine, path))
+        Some((header.machine, path, motion.margin_mm))
     }
 
     /// Every profile of this job with a partial file on disk.
-    pub fn cut_scans(&self) -> Vec<ProfileKey> {
+    fn cut_scans(&self) -> Vec<ProfileKey> {
         let partial = self.dir.partial_scans().unwrap_or_default();
         job_scans(&self.plan, self.record.kind)
             .into_iter()
@@ -328,43 +352,6 @@ impl Job {
 }
 
 /// The scans a job of this kind makes.
-/// How far the probe keeps off the known surface when entering and leaving a scan of a job of `kind`, mm.
-pub(super) fn scan_margin_mm(plan: &Plan, kind: JobKind) -> f64 {
-    match kind {
-        JobKind::Teach => TEACH_MARGIN_MM,
-        JobKind::Inspect => plan.scan_settings().max_deviation_mm + INSPECT_EXTRA_MARGIN_MM,
-    }
-}
-
-/// Refuses an inspection whose descents or ways out would bring the stylus closer to the taught part than the
-/// station's move margin (`clearance`).
-pub fn check_inspection_moves(
-    config: &StationConfig,
-    plan: &Plan,
-    reference: &Reference,
-) -> Result<(), JobError> {
-    let stylus = clearance::station_stylus(config).map_err(JobError)?;
-    let part = clearance::machine_part(plan, reference).map_err(JobError)?;
-    let moves = clearance::inspection_moves(
-        plan,
-        reference,
-        &job_scans(plan, JobKind::Inspect),
-        stylus.ball_radius_mm,
-        scan_margin_mm(plan, JobKind::Inspect),
-        config.safety.clearance_z_mm,
-    )
-    .map_err(JobError)?
-    .into_iter()
-    .filter(|m| m.kind != clearance::MoveKind::Scan)
-    .collect();
-    let margin = config.safety.move_margin_mm;
-    let checked = clearance::check_moves(&stylus, moves, &part, margin);
-    match clearance::refusal(plan, &checked, margin) {
-        Some(message) => Err(JobError(message)),
-        None => Ok(()),
-    }
-}
-
 pub fn job_scans(plan: &Plan, kind: JobKind) -> Vec<ProfileKey> {
     match kind {
         JobKind::Teach => plan.teach_scans(),

@@ -1,15 +1,19 @@
 //! The daemon: one task per machine owns its line (`worker`), one task per job analyses its points (`pipeline`),
-//! one task serves the control socket (`control`), and one task owns the station's state and makes every decision
-//! (`daemon`): which machine scans what next, when a job stops, resumes, or ends. They talk only through channels.
+//! one task serves the control socket (`control`), and one task owns the station's state (`daemon`, the shell
+//! around `core`, which makes every decision with no I/O: which machine scans what next, when a job stops,
+//! resumes, is aborted, or ends). Every scan's moves are planned once (`motion`), checked (`clearance`) and sent
+//! as planned (`worker`). They talk only through channels.
 
 pub mod clearance;
 pub mod clock;
 mod control;
+mod core;
 mod daemon;
 mod escape;
 mod finish;
 mod job;
 mod journal;
+mod motion;
 mod pipeline;
 mod recorder;
 mod worker;
@@ -19,7 +23,7 @@ use tokio::sync::{broadcast, mpsc, oneshot};
 use crate::api::{Reply, Request};
 use crate::config::StationConfig;
 use crate::plan::ProfileKey;
-use worker::ScanResult;
+use worker::{ScanResult, WorkerError};
 
 pub use escape::{way_out, EscapeError, KnownPath};
 
@@ -48,7 +52,12 @@ pub enum DaemonMsg {
     /// A worker cleared its machine (or could not).
     Cleared {
         machine: String,
-        result: Result<(), String>,
+        result: Result<(), WorkerError>,
+    },
+    /// A job was set up off the decision task (or could not be).
+    Prepared {
+        id: core::RequestId,
+        result: Result<Box<job::Job>, job::JobError>,
     },
     /// A job's reference was fitted or its report written.
     Finished {
@@ -85,7 +94,7 @@ pub async fn run(config: StationConfig) -> anyhow::Result<()> {
         .collect();
     tokio::spawn(control::serve(listener, to_daemon.clone(), events.clone()));
     let socket = config.control.socket.clone();
-    let state = daemon::Daemon::start(config, workers, events, to_daemon)?;
+    let state = daemon::Daemon::start(config, workers, events, to_daemon).await?;
     tracing::info!(socket = %socket.display(), "daemon ready");
     let result = tokio::select! {
         () = state.run(inbox) => Ok(()),

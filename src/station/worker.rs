@@ -1,7 +1,7 @@
-//! A machine worker: the one task that drives one CMM. It takes scan orders one at a time, moves the probe to the
-//! scan's entry at the clearance height, streams the scan's points to the job's pipeline as they arrive, and
-//! leaves the part the way it came. Anything that goes wrong ends the order with an error that names the machine
-//! and leaves the machine alone until the operator clears it.
+//! A machine worker: the one task that drives one CMM. It takes scan orders one at a time and executes each
+//! scan's planned motion (`motion`) exactly: the approach, the scan with its points streamed to the job's
+//! pipeline as they arrive, and the planned lift-off and way out. Anything that goes wrong ends the order with a
+//! typed error naming the machine, sends nothing more, and leaves the machine alone until the operator clears it.
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -11,49 +11,38 @@ use nalgebra::{Point3, Vector3};
 use tokio::sync::{broadcast, mpsc, oneshot};
 use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::machine::{
-    CurveScan, Error as MachineError, Event, InPlaneScan, Machine, ScanStream, Speeds, Xyz,
+    Error as MachineError, ErrorKind, Event, Machine, ScanStream, Speeds, Xyz,
 };
 use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
 
-use super::escape::{way_out, KnownPath};
-
-/// I++ error 0008, "Protocol error": what a controller answers to StartSession while it holds a session.
-const PROTOCOL_ERROR: u16 = 8;
+use super::escape::{plan_escape, EscapeModel, KnownPath};
+use super::motion::{Scan, ScanMotion};
 use super::pipeline::PipelineMsg;
 use super::DaemonMsg;
 use crate::analysis::RawPoint;
+use crate::api::{FaultKind, MachineFault};
 use crate::config::{MachineEntry, ProbeSettings, Safety};
-use crate::plan::ProfileKey;
+
+/// I++ error 0008, "Protocol error": what a controller answers to StartSession while it holds a session, and to
+/// other commands on a session it no longer holds.
+const PROTOCOL_ERROR: u16 = 8;
+/// A position this far below the clearance height still counts as at it (the rounding of a reported position), mm.
+const AT_HEIGHT_TOLERANCE_MM: f64 = 1e-3;
 
 /// What a worker is asked to do.
 pub enum Order {
-    Scan(ScanOrder),
-    /// Clear the machine's errors (reconnecting a lost link) and take the probe clear of the part, using `path`
-    /// and its margin (mm) when the worker has no path of its own (after a daemon restart: the partial scan on
-    /// disk).
-    Clear {
-        path: Option<(KnownPath, f64)>,
-        reply: oneshot::Sender<Result<(), String>>,
+    /// Scan one profile by its planned motion, every point to the job's pipeline.
+    Scan {
+        motion: Box<ScanMotion>,
+        pipeline: mpsc::Sender<PipelineMsg>,
     },
-}
-
-/// One profile to scan.
-pub struct ScanOrder {
-    pub key: ProfileKey,
-    pub scan: Scan,
-    /// The surface known before the scan (the nominal curve, or the teach's start point) and its entry.
-    pub path: KnownPath,
-    /// How far off the known surface the probe travels when entering and leaving, mm.
-    pub margin_mm: f64,
-    pub pipeline: mpsc::Sender<PipelineMsg>,
-}
-
-pub enum Scan {
-    /// The master's profile, shape unknown.
-    InPlane(InPlaneScan),
-    /// A profile along its taught nominal curve.
-    Curve(CurveScan),
+    /// Clear the machine's errors (reconnecting a lost link, re-opening its session) and take the probe clear of
+    /// the part by a way out planned from where it is and checked against what is known of the part.
+    Clear {
+        escape: EscapeModel,
+        reply: oneshot::Sender<Result<(), WorkerError>>,
+    },
 }
 
 /// The daemon's side of a worker.
@@ -72,7 +61,8 @@ pub type Link = Arc<dyn Machine>;
 pub type Connector = Box<dyn Fn() -> Result<Link, WorkerError> + Send + Sync>;
 
 impl WorkerHandle {
-    /// Stops all motion now (I++ `AbortE` jumps the machine's queue); the running order ends with an error.
+    /// Stops all motion now (I++ `AbortE` jumps the machine's queue); the running order ends with an error and
+    /// the machine stays locked out until `zeroset clear`.
     pub async fn abort(&self) {
         let client = self.link.lock().expect("not poisoned").clone();
         if let Some(client) = client {
@@ -119,7 +109,6 @@ pub fn spawn_on(
         session: false,
         ball_radius: None,
         path: None,
-        margin_mm: 0.0,
     };
     tokio::spawn(worker.run(inbox, daemon));
     handle
@@ -141,6 +130,7 @@ fn line_connector(entry: MachineEntry) -> Connector {
             None => open_pty(&port),
         };
         let line = line.map_err(|e| WorkerError {
+            kind: FaultKind::Transport,
             message: format!(
                 "machine {}: cannot open its line {port}: {e}; check the cable and that the controller is on, then run `zeroset clear`",
                 entry.name
@@ -162,23 +152,44 @@ struct Worker {
     session: bool,
     /// The active tool's ball radius once the machine is set up for this station.
     ball_radius: Option<f64>,
-    /// The surface around the probe as far as the station knows it: the last scan's.
-    path: Option<KnownPath>,
-    margin_mm: f64,
+    /// The surface around the probe as far as the station knows it, and its margin (mm): the last scan's.
+    path: Option<(KnownPath, f64)>,
 }
 
 /// How a scan order ended.
 pub type ScanResult = Result<(), WorkerError>;
 
-/// Why an order failed: what the operator reads, and whether the machine needs clearing.
-#[derive(Debug, Clone)]
+/// Why an order failed: its kind (what the daemon decides on) and what the operator reads.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
 pub struct WorkerError {
+    pub kind: FaultKind,
     pub message: String,
+}
+
+impl WorkerError {
+    pub fn fault(&self) -> MachineFault {
+        MachineFault {
+            kind: self.kind,
+            message: self.message.clone(),
+        }
+    }
 }
 
 impl From<MachineError> for WorkerError {
     fn from(error: MachineError) -> Self {
+        let kind = match error.kind() {
+            ErrorKind::Device(device) => FaultKind::Device {
+                severity: device.severity(),
+                code: device.code(),
+            },
+            ErrorKind::Transport(_) => FaultKind::Transport,
+            ErrorKind::LockedOut { .. } => FaultKind::LockedOut,
+            // A target that cannot be written (not finite) is a plan the station must not send.
+            ErrorKind::InvalidArgument(_) => FaultKind::Refused,
+        };
         WorkerError {
+            kind,
             message: error.to_string(),
         }
     }
@@ -188,15 +199,12 @@ impl Worker {
     async fn run(mut self, mut inbox: mpsc::Receiver<Order>, daemon: mpsc::Sender<DaemonMsg>) {
         while let Some(order) = inbox.recv().await {
             match order {
-                Order::Scan(order) => {
-                    let key = order.key;
+                Order::Scan { motion, pipeline } => {
+                    let key = motion.key;
                     // Alarms from before this order were reported with the order they stopped.
                     self.alarms();
-                    let result = self.scan(order).await.map_err(|e| self.with_alarms(e));
-                    if result.is_err() {
-                        // Set up again after any failure: a lost link, a restarted controller, a tool change.
-                        self.ball_radius = None;
-                    }
+                    let result = self.scan(*motion, pipeline).await;
+                    let result = result.map_err(|e| self.failed(e));
                     let report = DaemonMsg::ScanEnded {
                         machine: self.name.clone(),
                         key,
@@ -206,15 +214,38 @@ impl Worker {
                         return;
                     }
                 }
-                Order::Clear { path, reply } => {
-                    if let (None, Some((path, margin))) = (&self.path, path) {
-                        self.path = Some(path);
-                        self.margin_mm = margin;
+                Order::Clear { escape, reply } => {
+                    if let (None, Some(cut)) = (&self.path, escape.cut.clone()) {
+                        self.path = Some(cut);
                     }
                     self.alarms();
-                    let _ = reply.send(self.clear().await.map_err(|e| e.message));
+                    let result = self.clear(&escape).await.map_err(|e| self.failed(e));
+                    let _ = reply.send(result);
                 }
             }
+        }
+    }
+
+    /// A failed order's error led by the alarms raised meanwhile (an emergency stop ends a scan with "transaction
+    /// aborted", and the operator needs to read why, and the daemon to know it was an emergency stop); a lost
+    /// link is forgotten, so that the next order opens it again. Every failed order passes here.
+    fn failed(&mut self, error: WorkerError) -> WorkerError {
+        let alarms = self.alarms();
+        if error.kind == FaultKind::Transport {
+            *self.link.lock().expect("not poisoned") = None;
+            self.alarms = None;
+            self.session = false;
+        }
+        // Set up again after any failure: a lost link, a restarted controller, a tool change.
+        self.ball_radius = None;
+        let Some((first_kind, _)) = alarms.first() else {
+            return error;
+        };
+        let mut message: Vec<String> = alarms.iter().map(|(_, text)| text.clone()).collect();
+        message.push(error.message);
+        WorkerError {
+            kind: *first_kind,
+            message: message.join("; "),
         }
     }
 
@@ -229,52 +260,33 @@ impl Worker {
         }
         let client = (self.connect)()?;
         self.alarms = Some(client.events());
+        self.session = false;
         *self.link.lock().expect("not poisoned") = Some(client.clone());
         Ok(client)
     }
 
     /// The alarms the machine raised (an emergency stop, a collision) since they were last read.
-    fn alarms(&mut self) -> Vec<String> {
+    fn alarms(&mut self) -> Vec<(FaultKind, String)> {
         let mut alarms = Vec::new();
         if let Some(receiver) = self.alarms.as_mut() {
             while let Ok(event) = receiver.try_recv() {
                 if let Event::Unsolicited(alarm) = event {
-                    alarms.push(format!(
-                        "the machine raised error {:04} (severity {}): {}",
+                    let kind = FaultKind::Device {
+                        severity: alarm.severity(),
+                        code: alarm.code(),
+                    };
+                    let text = format!(
+                        "machine {}: the machine raised error {:04} (severity {}): {}",
+                        self.name,
                         alarm.code(),
                         alarm.severity(),
                         alarm.text()
-                    ));
+                    );
+                    alarms.push((kind, text));
                 }
             }
         }
         alarms
-    }
-
-    /// A failed order's error led by the alarms raised meanwhile: an emergency stop ends a scan with "transaction
-    /// aborted", and the operator needs to read why.
-    fn with_alarms(&mut self, error: WorkerError) -> WorkerError {
-        let mut parts = self.alarms();
-        parts.push(error.message);
-        WorkerError {
-            message: parts.join("; "),
-        }
-    }
-
-    /// Forgets a link that failed, so that the next order opens it again and starts over on it.
-    fn drop_link_if_lost(&mut self, error: &MachineError) {
-        if error.transport_error().is_some() {
-            *self.link.lock().expect("not poisoned") = None;
-            self.alarms = None;
-            self.session = false;
-            self.ball_radius = None;
-        }
-    }
-
-    /// A failed machine command as the order's error, the link forgotten if it was the link that failed.
-    fn fail(&mut self, error: MachineError) -> WorkerError {
-        self.drop_link_if_lost(&error);
-        error.into()
     }
 
     /// Starts a session on the link unless this worker holds one. A controller may still hold the session of a
@@ -286,16 +298,12 @@ impl Worker {
         }
         match client.start_session().await {
             Ok(()) => {}
-            Err(error)
-                if error
-                    .device_error()
-                    .is_some_and(|e| e.code() == PROTOCOL_ERROR) =>
-            {
+            Err(error) if is_protocol_error(&error) => {
                 tracing::warn!(machine = %self.name, "taking over a session left open on the machine");
                 let _ = client.end_session().await;
-                client.start_session().await.map_err(|e| self.fail(e))?;
+                client.start_session().await?;
             }
-            Err(error) => return Err(self.fail(error)),
+            Err(error) => return Err(error.into()),
         }
         self.session = true;
         Ok(())
@@ -308,23 +316,22 @@ impl Worker {
             return Ok((client, radius));
         }
         self.open_session(&client).await?;
-        if !client.is_homed().await.map_err(|e| self.fail(e))? {
-            self.leave(&client).await?;
-            client.home().await.map_err(|e| self.fail(e))?;
+        if !client.is_homed().await? {
+            // Homing moves every axis: only from above the part.
+            self.require_clearance_height(&client, "homing").await?;
+            client.home().await?;
         }
-        client
-            .change_tool(&self.probe.tool)
-            .await
-            .map_err(|e| self.fail(e))?;
+        client.change_tool(&self.probe.tool).await?;
         let speeds = Speeds {
             travel: self.probe.travel_mm_s,
             probing: self.probe.probing_mm_s,
             scanning: self.probe.scanning_mm_s,
         };
-        client.set_speeds(speeds).await.map_err(|e| self.fail(e))?;
-        let radius = client.tool_radius().await.map_err(|e| self.fail(e))?;
+        client.set_speeds(speeds).await?;
+        let radius = client.tool_radius().await?;
         if !(radius > 0.0 && radius <= self.safety.max_ball_radius_mm) {
             return Err(WorkerError {
+                kind: FaultKind::Refused,
                 message: format!(
                     "machine {}: tool {} has a ball radius of {radius} mm, outside (0, {}] mm allowed by the station's safety settings; qualify or change the tool",
                     self.name, self.probe.tool, self.safety.max_ball_radius_mm
@@ -335,62 +342,84 @@ impl Worker {
         Ok((client, radius))
     }
 
-    /// Takes the probe from wherever it is to the clearance height without crossing the part.
-    async fn leave(&self, client: &Link) -> Result<Point3<f64>, WorkerError> {
+    async fn position(&self, client: &Link) -> Result<Point3<f64>, WorkerError> {
         let here = client.position().await?;
-        let here = Point3::new(here.x, here.y, here.z);
-        let radius = self.ball_radius.unwrap_or(self.safety.max_ball_radius_mm);
-        let moves = way_out(
-            here,
-            self.path.as_ref(),
-            radius,
-            self.margin_mm,
-            self.safety.clearance_z_mm,
-        )
+        Ok(Point3::new(here.x, here.y, here.z))
+    }
+
+    /// Refuses to move unless the probe is at or above the clearance height, where free travel is planned.
+    async fn require_clearance_height(
+        &self,
+        client: &Link,
+        before: &str,
+    ) -> Result<Point3<f64>, WorkerError> {
+        let here = self.position(client).await?;
+        if here.z < self.safety.clearance_z_mm - AT_HEIGHT_TOLERANCE_MM {
+            return Err(WorkerError {
+                kind: FaultKind::Refused,
+                message: format!(
+                    "machine {}: the probe is at ({:.3}, {:.3}, {:.3}) mm, below the clearance height z = {} mm, \
+                     before {before}: nothing was moved; run `zeroset clear` to take it clear of the part",
+                    self.name, here.x, here.y, here.z, self.safety.clearance_z_mm
+                ),
+            });
+        }
+        Ok(here)
+    }
+
+    /// Clears the machine's errors (on a new link, starting a session does; a session the machine no longer
+    /// holds is opened again) and takes the probe clear of the part by a way out checked against the model.
+    async fn clear(&mut self, model: &EscapeModel) -> Result<(), WorkerError> {
+        let client = self.connect()?;
+        if self.session {
+            match client.clear_all_errors().await {
+                Ok(()) => {}
+                Err(error) if is_protocol_error(&error) => {
+                    // The machine no longer holds this worker's session (it was restarted, or its line dropped
+                    // and came back): start over on it.
+                    tracing::warn!(machine = %self.name, "the machine lost the session; opening it again");
+                    self.session = false;
+                    self.open_session(&client).await?;
+                }
+                Err(error) => return Err(error.into()),
+            }
+        } else {
+            self.open_session(&client).await?;
+        }
+        self.ball_radius = None;
+        let (client, radius) = self.prepare().await?;
+        let here = self.position(&client).await?;
+        let path = self.path.as_ref().map(|(path, margin)| (path, *margin));
+        let moves = plan_escape(here, path, radius, &self.safety, model)
         .map_err(|e| WorkerError {
+            kind: FaultKind::Refused,
             message: format!(
                 "machine {}: {e}; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
                 self.name, self.safety.clearance_z_mm
             ),
         })?;
-        let mut at = here;
         for target in moves {
             client.go_to(xyz(&target)).await?;
-            at = target;
         }
-        Ok(at)
-    }
-
-    /// Clears the machine's errors (on a new link, starting a session does) and takes the probe clear of the part.
-    async fn clear(&mut self) -> Result<(), WorkerError> {
-        let client = self.connect()?;
-        if self.session {
-            client.clear_all_errors().await.map_err(|e| self.fail(e))?;
-        } else {
-            self.open_session(&client).await?;
-        }
-        self.ball_radius = None;
-        let (client, _) = self.prepare().await?;
-        self.leave(&client).await?;
+        self.path = None;
         Ok(())
     }
 
-    async fn scan(&mut self, order: ScanOrder) -> ScanResult {
+    async fn scan(
+        &mut self,
+        motion: ScanMotion,
+        pipeline: mpsc::Sender<PipelineMsg>,
+    ) -> ScanResult {
         let (client, radius) = self.prepare().await?;
-        let moved = async {
-            self.leave(&client).await?;
-            let entry = order.path.entry_offset(radius, order.margin_mm);
-            client
-                .go_to(Xyz::new(entry.x, entry.y, self.safety.clearance_z_mm))
-                .await?;
-            client.go_to(xyz(&entry)).await?;
-            Ok::<_, WorkerError>(())
-        };
-        moved.await?;
-        // From the entry on, the probe is near the part: its way out is along this scan's path.
-        self.path = Some(order.path.clone());
-        self.margin_mm = order.margin_mm;
+        self.require_clearance_height(&client, &format!("the approach to {}", motion.name))
+            .await?;
+        for target in &motion.approach {
+            client.go_to(xyz(target)).await?;
+        }
+        // From the entry on, the probe is near the part: a way out after a stop follows this scan's path.
+        self.path = Some((motion.path.clone(), motion.margin_mm));
         let scanning = client.scanning().ok_or_else(|| WorkerError {
+            kind: FaultKind::Refused,
             message: format!(
                 "machine {}: its probe cannot scan; this station needs a scanning probe",
                 self.name
@@ -398,37 +427,58 @@ impl Worker {
         })?;
         // The pipeline opens the profile's partial file while the machine starts the scan, not while the first
         // points wait (opening a file costs most of a millisecond).
-        let pipeline = order.pipeline.clone();
         let start = PipelineMsg::Start {
-            key: order.key,
+            key: motion.key,
             machine: self.name.clone(),
             ball_radius_mm: radius,
-            entry: order.path.surface[order.path.entry],
+            entry: motion.path.surface[motion.path.entry],
         };
         if pipeline.send(start).await.is_err() {
             return Err(self.pipeline_gone());
         }
-        let started = match &order.scan {
+        let started = match &motion.scan {
             Scan::InPlane(plan) => scanning.scan_in_plane(plan.clone()).await,
             Scan::Curve(plan) => scanning.scan_on_curve(plan.clone()).await,
         };
-        let stream = match started {
-            Ok(stream) => stream,
-            Err(error) => {
-                let _ = pipeline.send(PipelineMsg::Cut { key: order.key }).await;
-                return Err(self.fail(error));
-            }
+        let streamed = match started {
+            Ok(stream) => self.stream(stream, &motion, &pipeline, radius).await,
+            Err(error) => Err(error.into()),
         };
-        let streamed = self.stream(stream, &order, radius).await;
         let end = match &streamed {
-            Ok(()) => PipelineMsg::End { key: order.key },
-            Err(_) => PipelineMsg::Cut { key: order.key },
+            Ok(()) => PipelineMsg::End { key: motion.key },
+            Err(_) => PipelineMsg::Cut { key: motion.key },
         };
         if pipeline.send(end).await.is_err() {
             return Err(self.pipeline_gone());
         }
         streamed?;
-        self.leave(&client).await?;
+        self.retract(&client, &motion).await
+    }
+
+    /// The planned lift-off and way out, sent only if the scan ended where the plan has it end.
+    async fn retract(&mut self, client: &Link, motion: &ScanMotion) -> ScanResult {
+        let here = self.position(client).await?;
+        let off = (here - motion.end).norm();
+        if off > motion.end_tolerance_mm {
+            return Err(WorkerError {
+                kind: FaultKind::Refused,
+                message: format!(
+                    "machine {}: the scan of {} ended at ({:.3}, {:.3}, {:.3}) mm, {off:.2} mm from its planned end \
+                     (more than {:.2} mm), so its planned way out is not the move to make: nothing was moved; run \
+                     `zeroset clear`",
+                    self.name,
+                    motion.name,
+                    here.x,
+                    here.y,
+                    here.z,
+                    motion.end_tolerance_mm
+                ),
+            });
+        }
+        for target in &motion.retract {
+            client.go_to(xyz(target)).await?;
+        }
+        self.path = None;
         Ok(())
     }
 
@@ -437,40 +487,39 @@ impl Worker {
     async fn stream(
         &mut self,
         mut stream: ScanStream,
-        order: &ScanOrder,
+        motion: &ScanMotion,
+        pipeline: &mpsc::Sender<PipelineMsg>,
         radius: f64,
     ) -> ScanResult {
-        let teaching = matches!(order.scan, Scan::InPlane(_));
+        let teaching = matches!(motion.scan, Scan::InPlane(_));
         while let Some(item) = stream.next().await {
             let received_us = super::clock::unix_us();
-            let point = match item {
-                Ok(point) => point,
-                Err(error) => return Err(self.fail(error)),
-            };
+            let point = item?;
             let raw = RawPoint {
                 centre: [point.centre.x, point.centre.y, point.centre.z],
                 normal: [point.normal.x, point.normal.y, point.normal.z],
                 quality: point.quality,
             };
             if teaching {
-                if let Some(path) = self.path.as_mut() {
-                    let normal = Vector3::from(raw.normal);
-                    path.surface
-                        .push(Point3::from(raw.centre) - normal * radius);
-                    path.normals.push(normal);
+                if let Some((path, _)) = self.path.as_mut() {
+                    if let Some(normal) = Vector3::from(raw.normal).try_normalize(1e-9) {
+                        path.surface
+                            .push(Point3::from(raw.centre) - normal * radius);
+                        path.normals.push(normal);
+                    }
                 }
             }
             let message = PipelineMsg::Point {
-                key: order.key,
+                key: motion.key,
                 raw,
                 received_us,
             };
-            if order.pipeline.send(message).await.is_err() {
+            if pipeline.send(message).await.is_err() {
                 return Err(self.pipeline_gone());
             }
         }
         if teaching {
-            if let Some(path) = self.path.as_mut() {
+            if let Some((path, _)) = self.path.as_mut() {
                 path.closed = true;
             }
         }
@@ -479,12 +528,19 @@ impl Worker {
 
     fn pipeline_gone(&self) -> WorkerError {
         WorkerError {
+            kind: FaultKind::Station,
             message: format!(
                 "machine {}: the job's analysis stopped; the scan was not recorded",
                 self.name
             ),
         }
     }
+}
+
+fn is_protocol_error(error: &MachineError) -> bool {
+    error
+        .device_error()
+        .is_some_and(|e| e.code() == PROTOCOL_ERROR)
 }
 
 fn xyz(p: &Point3<f64>) -> Xyz {

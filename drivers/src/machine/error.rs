@@ -57,7 +57,9 @@ pub enum TransportError {
 }
 
 impl Error {
-    pub(crate) fn new(machine: Arc<str>, command: String, kind: ErrorKind) -> Self {
+    /// An error of `machine`'s `command`: public so that drivers behind the trait, and fakes of it in tests, say
+    /// what failed the same way the I++ client does.
+    pub fn new(machine: Arc<str>, command: String, kind: ErrorKind) -> Self {
         Error {
             machine,
             command,

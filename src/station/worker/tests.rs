@@ -1,5 +1,6 @@
-//! The worker's motion logic against mocked machines: where it moves before and after a scan, and that it will not
-//! move a probe it cannot get clear safely.
+//! The worker's motion logic against mocked machines: it sends a scan's planned motion exactly, refuses to move
+//! when the probe is not where the plan has it, gets clear of the part only by a checked way out, and reopens a
+//! link or a session it lost.
 
 use std::sync::{Arc, Mutex};
 
@@ -13,6 +14,8 @@ use zeroset_drivers::machine::{
 use super::*;
 use crate::config::{ProbeSettings, Safety};
 use crate::plan::ProfileKey;
+use crate::station::clearance::{swept_moves, MoveKind};
+use zeroset_drivers::machine::TransportError;
 
 const CLEARANCE_MM: f64 = 150.0;
 const MARGIN_MM: f64 = 2.0;
@@ -73,11 +76,21 @@ fn curve_scan(path: &KnownPath) -> CurveScan {
 
 /// A machine that is homed and set up, reports `positions` one after another, and records its moves.
 fn machine(positions: Vec<Xyz>, moves: Arc<Mutex<Vec<Xyz>>>, scan: Vec<ScanPoint>) -> MockMachine {
+    let mut machine = bare_machine(positions, Some(moves), scan);
+    machine.expect_start_session().returning(|| Ok(()));
+    machine
+}
+
+/// Like [`machine`], without its session's expectations; every move fails with a lost link without `moves`.
+fn bare_machine(
+    positions: Vec<Xyz>,
+    moves: Option<Arc<Mutex<Vec<Xyz>>>>,
+    scan: Vec<ScanPoint>,
+) -> MockMachine {
     let mut machine = MockMachine::new();
     machine
         .expect_events()
         .returning(|| broadcast::channel(1).1);
-    machine.expect_start_session().returning(|| Ok(()));
     machine.expect_is_homed().returning(|| Ok(true));
     machine.expect_change_tool().returning(|_| Ok(()));
     machine.expect_set_speeds().returning(|_| Ok(()));
@@ -90,10 +103,15 @@ fn machine(positions: Vec<Xyz>, moves: Arc<Mutex<Vec<Xyz>>>, scan: Vec<ScanPoint
             .next()
             .expect("no more positions were expected"))
     });
-    machine.expect_go_to().returning(move |target| {
-        moves.lock().unwrap().push(target);
-        Ok(())
-    });
+    machine
+        .expect_go_to()
+        .returning(move |target| match &moves {
+            Some(moves) => {
+                moves.lock().unwrap().push(target);
+                Ok(())
+            }
+            None => Err(lost("GoTo")),
+        });
     let mut scanning = MockScanning::new();
     scanning
         .expect_scan_on_curve()
@@ -112,32 +130,47 @@ fn machine(positions: Vec<Xyz>, moves: Arc<Mutex<Vec<Xyz>>>, scan: Vec<ScanPoint
 
 fn worker_on(machine: MockMachine) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
     let machine: Link = Arc::new(machine);
+    worker_with(Box::new(move || Ok(machine.clone())))
+}
+
+fn worker_with(connector: Connector) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
     let (daemon, reports) = mpsc::channel(8);
-    let handle = spawn_on(
-        "cmm1".into(),
-        Box::new(move || Ok(machine.clone())),
-        probe(),
-        safety(),
-        daemon,
-    );
+    let handle = spawn_on("cmm1".into(), connector, probe(), safety(), daemon);
     (handle, reports)
 }
 
-fn order(path: KnownPath, pipeline: mpsc::Sender<PipelineMsg>) -> Order {
-    Order::Scan(ScanOrder {
-        key: ProfileKey {
-            instance: 1,
-            profile: 2,
-        },
-        scan: Scan::Curve(curve_scan(&path)),
+const KEY: ProfileKey = ProfileKey {
+    instance: 1,
+    profile: 2,
+};
+
+/// The circle's scan as the station plans it: entered over its top, for the largest ball the station accepts.
+fn motion() -> ScanMotion {
+    let path = circle();
+    ScanMotion::plan(
+        KEY,
+        "instance B, profile r300".into(),
+        Scan::Curve(curve_scan(&path)),
         path,
-        margin_mm: MARGIN_MM,
+        MARGIN_MM,
+        &safety(),
+    )
+    .expect("a plan")
+}
+
+fn scan_order(motion: ScanMotion, pipeline: mpsc::Sender<PipelineMsg>) -> Order {
+    Order::Scan {
+        motion: Box::new(motion),
         pipeline,
-    })
+    }
 }
 
 fn close(a: &Xyz, b: &Xyz) -> bool {
     (a.x - b.x).abs() < 1e-9 && (a.y - b.y).abs() < 1e-9 && (a.z - b.z).abs() < 1e-9
+}
+
+fn xyz_of(p: &Point3<f64>) -> Xyz {
+    Xyz::new(p.x, p.y, p.z)
 }
 
 fn point(z: f64) -> ScanPoint {
@@ -148,19 +181,7 @@ fn point(z: f64) -> ScanPoint {
     }
 }
 
-#[tokio::test]
-async fn a_scan_is_entered_from_above_streamed_in_order_and_left_the_way_it_came() {
-    let path = circle();
-    // Over the entry (the top at z = 20) by the ball and the margin: z = 23.
-    let entry = Xyz::new(100.0, 0.0, 23.0);
-    let moves = Arc::new(Mutex::new(Vec::new()));
-    // Homed at z = 400 before; at the end of the closed scan, back over the top, the ball 2 mm off the surface.
-    let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 23.0)];
-    let scanned = vec![point(21.0), point(21.001), point(20.999)];
-    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned.clone()));
-    let (pipeline, mut analysis) = mpsc::channel(16);
-    worker.orders.send(order(path, pipeline)).await.unwrap();
-
+async fn scan_result(reports: &mut mpsc::Receiver<DaemonMsg>) -> ScanResult {
     let DaemonMsg::ScanEnded {
         machine,
         key,
@@ -169,22 +190,71 @@ async fn a_scan_is_entered_from_above_streamed_in_order_and_left_the_way_it_came
     else {
         panic!("expected the end of the scan");
     };
+    assert_eq!((machine.as_str(), key), ("cmm1", KEY));
+    result
+}
+
+#[tokio::test]
+async fn a_scan_sends_exactly_its_planned_motion_which_is_what_the_clearance_check_sweeps() {
+    let motion = motion();
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    // Homed at z = 400 before; at the end of the closed scan back over the top, the 1 mm ball in contact.
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
+    let scanned = vec![point(21.0), point(21.001), point(20.999)];
+    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned.clone()));
+    let (pipeline, mut analysis) = mpsc::channel(16);
+    worker
+        .orders
+        .send(scan_order(motion.clone(), pipeline))
+        .await
+        .unwrap();
+    scan_result(&mut reports).await.expect("scanned");
+
+    let sent = moves.lock().unwrap().clone();
+    let planned: Vec<Xyz> = motion
+        .approach
+        .iter()
+        .chain(&motion.retract)
+        .map(xyz_of)
+        .collect();
     assert_eq!(
-        (machine.as_str(), key.instance, key.profile),
-        ("cmm1", 1, 2)
+        sent, planned,
+        "the wire's GoTo targets are the plan's, bit for bit"
     );
-    assert!(result.is_ok(), "{:?}", result.err());
-    let expected = [
-        Xyz::new(100.0, 0.0, CLEARANCE_MM),
-        entry,
-        entry,
-        Xyz::new(100.0, 0.0, CLEARANCE_MM),
-    ];
-    let moves = moves.lock().unwrap().clone();
+    // Over the entry (the top at z = 20) by the planned 1.5 mm ball and the margin, at the clearance height first.
     assert!(
-        moves.len() == expected.len() && moves.iter().zip(&expected).all(|(a, b)| close(a, b)),
-        "over the entry at the clearance height, down to it; after the scan back to it, then up: {moves:?}"
+        close(&sent[0], &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
+        "{sent:?}"
     );
+    assert!(close(&sent[1], &Xyz::new(100.0, 0.0, 23.5)), "{sent:?}");
+    assert!(
+        close(sent.last().unwrap(), &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
+        "{sent:?}"
+    );
+    // The clearance check sweeps the same positions: the descent between the approach's two, the lift-off from
+    // the planned end and every leg of the way out between the retract's.
+    let swept: Vec<(MoveKind, Xyz, Xyz)> = swept_moves(std::slice::from_ref(&motion))
+        .unwrap()
+        .into_iter()
+        .filter(|m| m.kind != MoveKind::Scan)
+        .map(|m| {
+            (
+                m.kind,
+                xyz_of(&m.motion.centre(0.0)),
+                xyz_of(&m.motion.centre(1.0)),
+            )
+        })
+        .collect();
+    assert_eq!(swept[0], (MoveKind::Descent, sent[0], sent[1]));
+    assert_eq!(swept[1], (MoveKind::LiftOff, xyz_of(&motion.end), sent[2]));
+    for (leg, (kind, from, to)) in swept[2..].iter().enumerate() {
+        assert_eq!(
+            (*kind, *from, *to),
+            (MoveKind::WayOut, sent[2 + leg], sent[3 + leg])
+        );
+    }
+    assert_eq!(swept.len(), sent.len() - 1);
+
     let PipelineMsg::Start {
         ball_radius_mm,
         entry,
@@ -214,37 +284,92 @@ async fn a_scan_is_entered_from_above_streamed_in_order_and_left_the_way_it_came
 }
 
 #[tokio::test]
-async fn a_probe_near_the_part_with_no_known_way_out_is_not_moved() {
+async fn below_the_clearance_height_before_a_scan_nothing_moves() {
     let moves = Arc::new(Mutex::new(Vec::new()));
-    // After a restart the probe is down at z = 10, below the clearance height, and no scan path is known.
+    // After a restart the probe is down at z = 10, below the clearance height.
     let positions = vec![Xyz::new(100.0, -25.0, 10.0)];
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), Vec::new()));
     let (pipeline, _analysis) = mpsc::channel(16);
-    worker.orders.send(order(circle(), pipeline)).await.unwrap();
-    let DaemonMsg::ScanEnded { result, .. } = reports.recv().await.unwrap() else {
-        panic!("expected the end of the scan");
-    };
-    let message = result.unwrap_err().message;
+    worker
+        .orders
+        .send(scan_order(motion(), pipeline))
+        .await
+        .unwrap();
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Refused);
     assert!(
-        message.contains("cmm1") && message.contains("jog the probe above z = 150 mm"),
-        "{message}"
+        error.message.contains("cmm1")
+            && error
+                .message
+                .contains("below the clearance height z = 150 mm")
+            && error.message.contains("zeroset clear"),
+        "{}",
+        error.message
     );
     assert!(moves.lock().unwrap().is_empty(), "no move at all");
+}
+
+#[tokio::test]
+async fn a_scan_that_ends_away_from_its_planned_end_is_not_retracted_by_the_plan() {
+    let motion = motion();
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    // The scan ended under the circle, 42 mm from where the plan has it end.
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, -21.0)];
+    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), vec![point(21.0)]));
+    let (pipeline, _analysis) = mpsc::channel(16);
+    worker
+        .orders
+        .send(scan_order(motion.clone(), pipeline))
+        .await
+        .unwrap();
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Refused, "{}", error.message);
+    assert!(
+        error.message.contains("from its planned end"),
+        "{}",
+        error.message
+    );
+    let sent = moves.lock().unwrap().clone();
+    assert_eq!(sent, motion.approach.iter().map(xyz_of).collect::<Vec<_>>());
+}
+
+/// Every point of every straight move from `position` through `moves` keeps the ball (radius 1) out of the circle
+/// (radius 20); returns the least clearance after the first leg.
+fn clearance_round_the_circle(position: Xyz, moves: &[Xyz]) -> f64 {
+    let mut from = Point3::new(position.x, position.y, position.z);
+    let mut least_after_first = f64::INFINITY;
+    for (leg, to) in moves.iter().enumerate() {
+        let to = Point3::new(to.x, to.y, to.z);
+        for k in 0..=200 {
+            let p = from + (to - from) * (k as f64 / 200.0);
+            let clearance = (p.y.powi(2) + p.z.powi(2)).sqrt() - 20.0 - 1.0;
+            assert!(
+                clearance > -1e-9,
+                "the move {from} -> {to} cuts the part at {p}"
+            );
+            if leg > 0 {
+                least_after_first = least_after_first.min(clearance);
+            }
+        }
+        from = to;
+    }
+    least_after_first
 }
 
 #[tokio::test]
 async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     let moves = Arc::new(Mutex::new(Vec::new()));
     // A daemon was killed with the ball under the circle (z = -21); the new daemon knows the cut scan's path.
-    let positions = vec![Xyz::new(100.0, 0.0, -21.0)];
-    let (worker, _reports) = worker_on(machine(positions, moves.clone(), Vec::new()));
+    let position = Xyz::new(100.0, 0.0, -21.0);
+    let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
     let (reply, answer) = tokio::sync::oneshot::channel();
+    let escape = EscapeModel {
+        cut: Some((circle(), MARGIN_MM)),
+        part: None,
+    };
     worker
         .orders
-        .send(Order::Clear {
-            path: Some((circle(), MARGIN_MM)),
-            reply,
-        })
+        .send(Order::Clear { escape, reply })
         .await
         .unwrap();
     answer.await.unwrap().expect("cleared");
@@ -253,13 +378,131 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
         close(moves.last().unwrap(), &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
         "{moves:?}"
     );
-    // Round the circle, never through it: every waypoint at least the ball and the margin off the surface.
-    for target in moves.iter() {
-        let off = (target.y.powi(2) + target.z.powi(2)).sqrt() - 20.0;
-        assert!(
-            off >= 1.0 + MARGIN_MM - 1e-9,
-            "{target:?} is {off} mm off the circle"
-        );
-    }
+    // Round the circle, never through it, the margin kept once off the surface, less the sag of the chords
+    // between waypoints 10 degrees apart on the offset circle (23 mm (1 - cos 5 deg) = 0.09 mm).
+    let least = clearance_round_the_circle(position, &moves);
+    assert!(least >= MARGIN_MM - 0.09, "{least} mm");
     assert!(moves.len() > 10, "{} moves", moves.len());
+}
+
+#[tokio::test]
+async fn a_probe_near_the_part_with_no_known_way_out_is_not_moved_by_a_clear() {
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let (worker, _reports) = worker_on(machine(
+        vec![Xyz::new(100.0, -25.0, 10.0)],
+        moves.clone(),
+        Vec::new(),
+    ));
+    let (reply, answer) = tokio::sync::oneshot::channel();
+    worker
+        .orders
+        .send(Order::Clear {
+            escape: EscapeModel::default(),
+            reply,
+        })
+        .await
+        .unwrap();
+    let error = answer.await.unwrap().unwrap_err();
+    assert_eq!(error.kind, FaultKind::Refused);
+    assert!(
+        error.message.contains("jog the probe above z = 150 mm"),
+        "{}",
+        error.message
+    );
+    assert!(moves.lock().unwrap().is_empty());
+}
+
+fn lost(command: &str) -> MachineError {
+    MachineError::new(
+        "cmm1".into(),
+        command.into(),
+        ErrorKind::Transport(TransportError::Disconnected),
+    )
+}
+
+#[tokio::test]
+async fn a_lost_link_is_opened_again_by_the_next_order_not_reused() {
+    let opened = Arc::new(Mutex::new(0usize));
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let connector: Connector = {
+        let (opened, moves) = (opened.clone(), moves.clone());
+        Box::new(move || {
+            let mut count = opened.lock().unwrap();
+            *count += 1;
+            let positions = vec![Xyz::new(0.0, 0.0, 400.0); 2];
+            // The first link dies under the approach (through `?`, not a named failure path).
+            let moves = (*count > 1).then(|| moves.clone());
+            let mut machine = bare_machine(positions, moves, Vec::new());
+            machine.expect_start_session().returning(|| Ok(()));
+            Ok(Arc::new(machine) as Link)
+        })
+    };
+    let (worker, mut reports) = worker_with(connector);
+    let (pipeline, _analysis) = mpsc::channel(16);
+    worker
+        .orders
+        .send(scan_order(motion(), pipeline))
+        .await
+        .unwrap();
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Transport, "{}", error.message);
+    let (reply, answer) = tokio::sync::oneshot::channel();
+    worker
+        .orders
+        .send(Order::Clear {
+            escape: EscapeModel::default(),
+            reply,
+        })
+        .await
+        .unwrap();
+    answer.await.unwrap().expect("cleared on a new link");
+    assert_eq!(
+        *opened.lock().unwrap(),
+        2,
+        "the dead link was dropped and a new one opened"
+    );
+}
+
+#[tokio::test]
+async fn a_clear_on_a_session_the_machine_lost_starts_it_again() {
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let mut machine = bare_machine(vec![Xyz::new(0.0, 0.0, 400.0); 3], Some(moves), Vec::new());
+    let sessions = Arc::new(Mutex::new(0usize));
+    {
+        let sessions = sessions.clone();
+        machine.expect_start_session().returning(move || {
+            *sessions.lock().unwrap() += 1;
+            Ok(())
+        });
+    }
+    machine.expect_clear_all_errors().returning(|| {
+        let error = zeroset_drivers::wire::DeviceError::new(
+            3,
+            PROTOCOL_ERROR,
+            zeroset_drivers::wire::WireString::new("ClearAllErrors").unwrap(),
+            zeroset_drivers::wire::WireString::new("Protocol error").unwrap(),
+        )
+        .unwrap();
+        Err(MachineError::new(
+            "cmm1".into(),
+            "ClearAllErrors()".into(),
+            ErrorKind::Device(error),
+        ))
+    });
+    machine.expect_end_session().returning(|| Ok(()));
+    let (worker, _reports) = worker_on(machine);
+    for _ in 0..2 {
+        let (reply, answer) = tokio::sync::oneshot::channel();
+        worker
+            .orders
+            .send(Order::Clear {
+                escape: EscapeModel::default(),
+                reply,
+            })
+            .await
+            .unwrap();
+        answer.await.unwrap().expect("cleared");
+    }
+    // The first clear opens the session; the second finds it lost (0008) and opens it again.
+    assert_eq!(*sessions.lock().unwrap(), 2);
 }

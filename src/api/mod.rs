@@ -9,10 +9,14 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::stats::{DeviationStats, Verdict};
+mod results;
+mod states;
+
+pub use results::{DeviationStats, Verdict};
+pub use states::{FaultKind, JobPhase, MachineFault, MachineState};
 
 /// The version of these types; bumped on any change a reader of the old version would misread.
-pub const API_VERSION: u32 = 1;
+pub const API_VERSION: u32 = 2;
 
 /// One request line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,7 +66,7 @@ pub enum Reply {
     Done {
         message: String,
     },
-    Status(StationStatus),
+    Status(Box<StationStatus>),
     Report {
         dir: PathBuf,
         summary: String,
@@ -191,13 +195,14 @@ pub struct ScanRef {
     pub profile: String,
 }
 
-/// How well a taught profile was fitted.
+/// How well a taught profile was fitted: the distances of its points to the reference, mm (`None` where the
+/// reference kind keeps no such statistic).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProfileFit {
     pub profile: String,
     pub points: usize,
-    pub rms_mm: f64,
-    pub max_mm: f64,
+    pub rms_mm: Option<f64>,
+    pub max_mm: Option<f64>,
 }
 
 /// One instance's result.
@@ -213,23 +218,29 @@ pub struct InstanceSummary {
 pub struct StationStatus {
     pub station: String,
     pub machines: Vec<MachineStatus>,
+    /// A job being set up (its part and reference loaded, its moves checked) before it starts.
+    pub preparing: Option<PreparingJob>,
     pub job: Option<JobStatus>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MachineStatus {
     pub name: String,
-    /// e.g. "idle", "scanning instance B, profile r300", "locked out: emergency stop".
-    pub state: String,
+    pub state: MachineState,
+}
+
+/// A job requested and being set up.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PreparingJob {
+    pub kind: JobKind,
+    pub part: String,
+    pub serial: Option<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JobStatus {
     pub job: JobInfo,
-    /// "running", "stopped", "fitting", "finished", "aborted" or "failed".
-    pub state: String,
-    /// Why it stopped and what to do, when it did.
-    pub stopped: Option<String>,
+    pub state: JobPhase,
     pub profiles_done: usize,
     pub profiles_total: usize,
 }
@@ -302,7 +313,7 @@ mod tests {
         }));
         assert_eq!(
             line,
-            "{\"version\":1,\"request\":\"inspect\",\"part\":\"propeller\",\"serial\":\"SN-1\"}\n"
+            "{\"version\":2,\"request\":\"inspect\",\"part\":\"propeller\",\"serial\":\"SN-1\"}\n"
         );
         let back: RequestLine = parse_line(line.trim()).unwrap();
         assert_eq!(
@@ -316,9 +327,9 @@ mod tests {
 
     #[test]
     fn another_version_is_refused_by_name() {
-        let err = parse_line::<RequestLine>("{\"version\":2,\"request\":\"status\"}").unwrap_err();
-        assert!(err.to_string().contains("version 2"), "{err}");
-        let err = parse_line::<RequestLine>("{\"version\":1,\"request\":\"fly\"}").unwrap_err();
+        let err = parse_line::<RequestLine>("{\"version\":1,\"request\":\"status\"}").unwrap_err();
+        assert!(err.to_string().contains("version 1"), "{err}");
+        let err = parse_line::<RequestLine>("{\"version\":2,\"request\":\"fly\"}").unwrap_err();
         assert!(err.to_string().contains("fly"), "{err}");
     }
 

@@ -1,0 +1,749 @@
+//! The daemon's decisions, with no I/O: `Core::handle(input) -> effects`, like the simulator's `Controller`. It
+//! owns the machines' states and the job, and decides which machine scans what next, when a job stops, resumes,
+//! is aborted or ends. Everything slow (loading and checking a job, writing records, fitting, reports) is an
+//! effect that the shell (`daemon`) runs off this task and that comes back as an input, so `status` and `abort`
+//! are answered at once whatever a job is doing.
+//!
+//! Safety rules kept here: a machine's lockout (an alarm, a fault, an operator's abort) is lifted only by an
+//! operator's `zeroset clear`; an abort sends AbortE to the scanning machines and nothing else, never a clear or
+//! a move; a job does not start while any machine is locked out.
+
+use nalgebra::Point3;
+
+use super::escape::{EscapeModel, KnownPath};
+use super::finish::Outcome;
+use super::job::{Job, JobError};
+use super::journal::{JobDir, JobRecord, JobState};
+use super::motion::ScanMotion;
+use super::pipeline::scan_ref;
+use super::worker::{ScanResult, WorkerError};
+use crate::api::{
+    Event, FaultKind, JobKind, JobPhase, JobStatus, MachineFault, MachineState, MachineStatus,
+    PreparingJob, Reply, Request, StationStatus,
+};
+use crate::plan::ProfileKey;
+
+/// Which request a reply answers; the shell keeps the reply channels.
+pub type RequestId = u64;
+
+/// What the core hears.
+pub enum Input {
+    Request {
+        id: RequestId,
+        request: Request,
+    },
+    /// A job was set up (or could not be) off the decision task.
+    Prepared {
+        id: RequestId,
+        result: Result<Box<Job>, JobError>,
+    },
+    /// A worker ended a scan order (or the order could not be given).
+    ScanEnded {
+        machine: String,
+        key: ProfileKey,
+        result: ScanResult,
+    },
+    /// The recorder stored a profile's scan on disk (or could not).
+    Stored {
+        job: String,
+        key: ProfileKey,
+        result: Result<(), String>,
+    },
+    /// A worker cleared its machine (or could not).
+    Cleared {
+        machine: String,
+        result: Result<(), WorkerError>,
+    },
+    /// A job's reference was fitted or its report written (or not).
+    Finished {
+        job: String,
+        result: Result<Outcome, String>,
+    },
+}
+
+/// What the core asks the shell to do.
+pub enum Effect {
+    Reply {
+        id: RequestId,
+        reply: Reply,
+    },
+    Publish(Event),
+    /// Load and check a new job; the result comes back as [`Input::Prepared`].
+    Prepare {
+        id: RequestId,
+        kind: JobKind,
+        part: String,
+        serial: Option<String>,
+    },
+    /// A fresh analysis pipeline for the current job (at its start and when it resumes).
+    StartPipeline,
+    /// The current job's analysis is no longer needed (it is over or finishing).
+    StopPipeline,
+    /// Execute this planned motion on `machine`, its points to the job's pipeline.
+    Scan {
+        machine: String,
+        motion: Box<ScanMotion>,
+    },
+    /// AbortE on `machine`: stop its motion now.
+    Abort {
+        machine: String,
+    },
+    /// Clear `machine`'s errors and take its probe clear of the part.
+    Clear {
+        machine: String,
+        escape: EscapeModel,
+    },
+    /// Record how the job stands, on disk (fsynced).
+    SaveRecord {
+        dir: JobDir,
+        record: JobRecord,
+    },
+    /// Fit the reference (teach) or write the report (inspect) from the scans on disk; comes back as
+    /// [`Input::Finished`].
+    Finish,
+    /// Read the newest report of a serial number and answer `id` with it.
+    ReadReport {
+        id: RequestId,
+        serial: String,
+    },
+}
+
+/// A machine as the core sees it.
+struct Slot {
+    name: String,
+    state: MachineState,
+    /// Where its last scan started, for choosing the nearest next one.
+    at: Option<Point3<f64>>,
+}
+
+/// A job being set up.
+struct Preparing {
+    id: RequestId,
+    job: PreparingJob,
+    /// The operator aborted it before it started.
+    aborted: bool,
+}
+
+pub struct Core {
+    station: String,
+    slots: Vec<Slot>,
+    preparing: Option<Preparing>,
+    job: Option<Job>,
+    /// The request owed an answer once every machine has cleared.
+    clearing: Option<RequestId>,
+    effects: Vec<Effect>,
+}
+
+const CLEAR_TO_CONTINUE: &str =
+    "remove the cause, then run `zeroset clear`: the job continues from its last complete profile";
+
+impl Core {
+    /// The station's machines, all idle, and a job a previous daemon left open (stopped until `zeroset clear`).
+    pub fn new(station: String, machines: Vec<String>, reopened: Option<Job>) -> Core {
+        Core {
+            station,
+            slots: machines
+                .into_iter()
+                .map(|name| Slot {
+                    name,
+                    state: MachineState::Idle,
+                    at: None,
+                })
+                .collect(),
+            preparing: None,
+            job: reopened,
+            clearing: None,
+            effects: Vec::new(),
+        }
+    }
+
+    /// The current job (for the shell's pipeline and finishing work).
+    pub fn job(&self) -> Option<&Job> {
+        self.job.as_ref()
+    }
+
+    /// Handles one input; returns what the shell must do, in order.
+    pub fn handle(&mut self, input: Input) -> Vec<Effect> {
+        match input {
+            Input::Request { id, request } => self.request(id, request),
+            Input::Prepared { id, result } => self.prepared(id, result),
+            Input::ScanEnded {
+                machine,
+                key,
+                result,
+            } => self.scan_ended(&machine, key, result),
+            Input::Stored { job, key, result } => self.stored(&job, key, result),
+            Input::Cleared { machine, result } => self.cleared(&machine, result),
+            Input::Finished { job, result } => self.finished(&job, result),
+        }
+        self.dispatch();
+        self.finish_if_complete();
+        std::mem::take(&mut self.effects)
+    }
+
+    fn emit(&mut self, effect: Effect) {
+        self.effects.push(effect);
+    }
+
+    fn reply(&mut self, id: RequestId, reply: Reply) {
+        self.emit(Effect::Reply { id, reply });
+    }
+
+    fn refuse(&mut self, id: RequestId, message: String) {
+        self.reply(id, Reply::Error { message });
+    }
+
+    fn publish(&mut self, event: Event) {
+        self.emit(Effect::Publish(event));
+    }
+
+    fn request(&mut self, id: RequestId, request: Request) {
+        match request {
+            Request::Status => {
+                let status = self.status();
+                self.reply(id, Reply::Status(Box::new(status)));
+            }
+            Request::Teach { part } => self.start_job(id, JobKind::Teach, part, None),
+            Request::Inspect { part, serial } => {
+                self.start_job(id, JobKind::Inspect, part, Some(serial))
+            }
+            Request::Abort => self.abort(id),
+            Request::Clear => self.clear(id),
+            Request::Report { serial } => self.emit(Effect::ReadReport { id, serial }),
+            // The control task answers subscriptions itself.
+            Request::Subscribe => self.reply(id, Reply::Subscribed),
+        }
+    }
+
+    fn start_job(&mut self, id: RequestId, kind: JobKind, part: String, serial: Option<String>) {
+        if let Some(preparing) = &self.preparing {
+            let message = format!(
+                "a job on part {} is being set up; wait for it to start, or `zeroset abort` it",
+                preparing.job.part
+            );
+            return self.refuse(id, message);
+        }
+        if let Some(job) = self.job.as_ref().filter(|j| !j.is_over()) {
+            let message = format!(
+                "job {} is not over ({}); wait for it, run `zeroset clear` to continue it, or `zeroset abort` to end it",
+                job.info.id, job.phase
+            );
+            return self.refuse(id, message);
+        }
+        if let Some(serial) = &serial {
+            let usable = !serial.is_empty()
+                && serial
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+                && !serial.starts_with('.');
+            if !usable {
+                let message = format!("serial number {serial:?}: use letters, digits, '-', '_' and '.' (it names the report's folder)");
+                return self.refuse(id, message);
+            }
+        }
+        if let Some(message) = self.machines_not_ready() {
+            return self.refuse(id, message);
+        }
+        self.preparing = Some(Preparing {
+            id,
+            job: PreparingJob {
+                kind,
+                part: part.clone(),
+                serial: serial.clone(),
+            },
+            aborted: false,
+        });
+        self.emit(Effect::Prepare {
+            id,
+            kind,
+            part,
+            serial,
+        });
+    }
+
+    /// Why no job may start now: a machine locked out (only `zeroset clear` lifts that) or being cleared.
+    fn machines_not_ready(&self) -> Option<String> {
+        let blocked: Vec<String> = self
+            .slots
+            .iter()
+            .filter(|s| !matches!(s.state, MachineState::Idle))
+            .map(|s| format!("machine {} is {}", s.name, s.state))
+            .collect();
+        (!blocked.is_empty()).then(|| {
+            format!(
+                "no job can start: {}; run `zeroset clear` once the cause is removed",
+                blocked.join("; ")
+            )
+        })
+    }
+
+    fn prepared(&mut self, id: RequestId, result: Result<Box<Job>, JobError>) {
+        let Some(preparing) = self.preparing.take().filter(|p| p.id == id) else {
+            return;
+        };
+        let mut job = match result {
+            Ok(job) => *job,
+            Err(error) => return self.refuse(id, error.to_string()),
+        };
+        if preparing.aborted {
+            job.record.state = JobState::Aborted;
+            job.phase = JobPhase::Aborted;
+            let message = format!(
+                "job {} was aborted before it started; no machine moved",
+                job.info.id
+            );
+            self.save_record(&job);
+            self.job = Some(job);
+            return self.refuse(id, message);
+        }
+        // A machine may have failed a clear meanwhile.
+        if let Some(message) = self.machines_not_ready() {
+            job.record.state = JobState::Failed {
+                error: message.clone(),
+            };
+            job.phase = JobPhase::Failed {
+                error: message.clone(),
+            };
+            self.save_record(&job);
+            self.job = Some(job);
+            return self.refuse(id, message);
+        }
+        let info = job.info.clone();
+        tracing::info!(job = %info.id, kind = ?info.kind, part = %info.part, "job started");
+        self.job = Some(job);
+        self.emit(Effect::StartPipeline);
+        self.publish(Event::JobStarted {
+            job: info.clone(),
+            done: Vec::new(),
+        });
+        self.reply(id, Reply::Started { job: info });
+    }
+
+    /// Gives every idle machine the remaining scan nearest to it.
+    fn dispatch(&mut self) {
+        let Some(job) = self.job.as_mut() else {
+            return;
+        };
+        if job.phase != JobPhase::Running {
+            return;
+        }
+        let mut orders = Vec::new();
+        for slot in &mut self.slots {
+            if slot.state != MachineState::Idle || job.remaining.is_empty() {
+                continue;
+            }
+            let from = slot.at.unwrap_or_else(|| Point3::new(0.0, 0.0, 0.0));
+            let Some(index) = job
+                .plan
+                .nearest(&job.remaining, from, |key| job.scan_start(key))
+            else {
+                continue;
+            };
+            let key = job.remaining.remove(index);
+            let scan = scan_ref(&job.plan, key);
+            slot.state = MachineState::Scanning { scan: scan.clone() };
+            slot.at = Some(job.scan_start(key));
+            tracing::info!(job = %job.info.id, machine = %slot.name, scan = %job.plan.describe(key), "scan started");
+            orders.push((slot.name.clone(), Box::new(job.motions[&key].clone()), scan));
+        }
+        let id = job.info.id.clone();
+        for (machine, motion, scan) in orders {
+            self.publish(Event::ScanStarted {
+                job: id.clone(),
+                machine: machine.clone(),
+                scan,
+                at_unix_ms: super::clock::unix_ms(),
+            });
+            self.emit(Effect::Scan { machine, motion });
+        }
+    }
+
+    fn slot(&mut self, machine: &str) -> Option<&mut Slot> {
+        self.slots.iter_mut().find(|s| s.name == machine)
+    }
+
+    fn scanning(&self) -> bool {
+        self.slots
+            .iter()
+            .any(|s| matches!(s.state, MachineState::Scanning { .. }))
+    }
+
+    fn scan_ended(&mut self, machine: &str, key: ProfileKey, result: ScanResult) {
+        let aborting = self
+            .job
+            .as_ref()
+            .is_some_and(|j| j.phase == JobPhase::Aborting);
+        let fault = result.err().map(|error| {
+            let mut fault = error.fault();
+            // The scan an abort cut ends with the machine's "transaction aborted"; an alarm keeps its own kind.
+            let alarm =
+                matches!(fault.kind, FaultKind::Device { code, .. } if code == 500 || code == 2504);
+            if aborting && !alarm {
+                fault.kind = FaultKind::Aborted;
+            }
+            fault
+        });
+        if let Some(slot) = self.slot(machine) {
+            slot.state = match &fault {
+                None => MachineState::Idle,
+                Some(fault) => MachineState::LockedOut {
+                    fault: fault.clone(),
+                },
+            };
+        }
+        if let (Some(job), Some(fault)) = (self.job.as_mut(), &fault) {
+            if !job.stored.contains(&key) && !job.remaining.contains(&key) {
+                job.remaining.push(key);
+            }
+            if job.phase == JobPhase::Running {
+                let scan = scan_ref(&job.plan, key);
+                tracing::error!(job = %job.info.id, machine, scan = %job.plan.describe(key), error = %fault.message, "job stopped");
+                job.phase = JobPhase::Stopped {
+                    machine: Some(machine.to_string()),
+                    scan: Some(scan.clone()),
+                    reason: format!(
+                        "{} of part {}: {}",
+                        job.plan.describe(key),
+                        job.info.part,
+                        fault.message
+                    ),
+                    next_step: CLEAR_TO_CONTINUE.to_string(),
+                };
+                let event = Event::JobStopped {
+                    job: job.info.id.clone(),
+                    machine: Some(machine.to_string()),
+                    scan: Some(scan),
+                    reason: fault.message.clone(),
+                    next_step: CLEAR_TO_CONTINUE.to_string(),
+                };
+                self.publish(event);
+            }
+        }
+        self.abort_done_if_stopped();
+    }
+
+    fn stored(&mut self, job_id: &str, key: ProfileKey, result: Result<(), String>) {
+        let Some(job) = self.job.as_mut().filter(|j| j.info.id == job_id) else {
+            return;
+        };
+        let error = match result {
+            Ok(()) => {
+                job.stored.insert(key);
+                return;
+            }
+            Err(error) => error,
+        };
+        if !job.remaining.contains(&key) {
+            job.remaining.push(key);
+        }
+        if job.phase != JobPhase::Running {
+            return;
+        }
+        let next_step =
+            "free space or fix the data folder's permissions, then run `zeroset clear`".to_string();
+        let reason = format!(
+            "{} of part {}: its points could not be stored: {error}",
+            job.plan.describe(key),
+            job.info.part
+        );
+        let scan = scan_ref(&job.plan, key);
+        job.phase = JobPhase::Stopped {
+            machine: None,
+            scan: Some(scan.clone()),
+            reason: reason.clone(),
+            next_step: next_step.clone(),
+        };
+        let event = Event::JobStopped {
+            job: job_id.to_string(),
+            machine: None,
+            scan: Some(scan),
+            reason,
+            next_step,
+        };
+        self.publish(event);
+    }
+
+    /// Starts the fit or the report once every profile is on disk and no machine is still scanning.
+    fn finish_if_complete(&mut self) {
+        let busy = self.scanning();
+        let Some(job) = self.job.as_mut() else {
+            return;
+        };
+        if job.phase != JobPhase::Running || busy || job.stored.len() < job.total {
+            return;
+        }
+        job.phase = JobPhase::Finishing;
+        self.emit(Effect::StopPipeline);
+        self.emit(Effect::Finish);
+    }
+
+    fn finished(&mut self, job_id: &str, result: Result<Outcome, String>) {
+        let Some(job) = self.job.as_mut().filter(|j| j.info.id == job_id) else {
+            return;
+        };
+        let event = match result {
+            Ok(Outcome::Taught { path, profiles }) => {
+                job.record.state = JobState::Finished;
+                job.phase = JobPhase::Finished;
+                Event::ReferenceSaved {
+                    job: job_id.to_string(),
+                    part: job.info.part.clone(),
+                    path,
+                    profiles,
+                }
+            }
+            Ok(Outcome::Inspected {
+                dir,
+                instances,
+                verdict,
+            }) => {
+                job.record.state = JobState::Finished;
+                job.record.report = Some(dir.clone());
+                job.phase = JobPhase::Finished;
+                Event::JobFinished {
+                    job: job_id.to_string(),
+                    report: Some(dir),
+                    instances,
+                    verdict: Some(verdict),
+                }
+            }
+            Err(error) => {
+                job.record.state = JobState::Failed {
+                    error: error.clone(),
+                };
+                job.phase = JobPhase::Failed {
+                    error: error.clone(),
+                };
+                Event::JobFailed {
+                    job: job_id.to_string(),
+                    error,
+                }
+            }
+        };
+        tracing::info!(job = job_id, phase = %job.phase, "job over");
+        let (dir, record) = (job.dir.clone(), job.record.clone());
+        self.emit(Effect::SaveRecord { dir, record });
+        self.publish(event);
+    }
+
+    fn abort(&mut self, id: RequestId) {
+        if let Some(preparing) = self.preparing.as_mut() {
+            preparing.aborted = true;
+            let message = format!(
+                "the job on part {} that is being set up will not start; no machine moves",
+                preparing.job.part
+            );
+            return self.reply(id, Reply::Done { message });
+        }
+        let Some(job) = self.job.as_mut().filter(|j| !j.is_over()) else {
+            return self.refuse(id, "no job to abort".into());
+        };
+        let job_id = job.info.id.clone();
+        match &job.phase {
+            JobPhase::Finishing => {
+                let message = format!(
+                    "job {job_id} has every profile on disk and is being finished; it cannot be aborted now"
+                );
+                self.refuse(id, message);
+            }
+            JobPhase::Aborting => {
+                self.refuse(id, format!("job {job_id} is already being aborted"));
+            }
+            phase => {
+                // A stopped job's faulted machines stay as the fault left them, locked out until `zeroset
+                // clear`; only machines still scanning are stopped.
+                let stopped = matches!(phase, JobPhase::Stopped { .. });
+                job.phase = JobPhase::Aborting;
+                let scanning: Vec<String> = self
+                    .slots
+                    .iter()
+                    .filter(|s| matches!(s.state, MachineState::Scanning { .. }))
+                    .map(|s| s.name.clone())
+                    .collect();
+                for machine in &scanning {
+                    self.emit(Effect::Abort {
+                        machine: machine.clone(),
+                    });
+                }
+                tracing::warn!(job = %job_id, machines = ?scanning, "aborted by the operator");
+                self.abort_done_if_stopped();
+                let mut message =
+                    format!("job {job_id} is aborted (its scans so far stay on disk)");
+                if !scanning.is_empty() {
+                    message.push_str(&format!("; motion stopped on {}", scanning.join(", ")));
+                }
+                message.push_str(if stopped {
+                    "; no machine was cleared or moved: run `zeroset clear` once the cause of the stop is removed"
+                } else if scanning.is_empty() {
+                    ""
+                } else {
+                    "; run `zeroset clear` to take the probe clear of the part"
+                });
+                self.reply(id, Reply::Done { message });
+            }
+        }
+    }
+
+    /// Once an aborted job's machines have stopped, the job is over. They stay locked out: lifting that is the
+    /// operator's `zeroset clear`.
+    fn abort_done_if_stopped(&mut self) {
+        if self.scanning() {
+            return;
+        }
+        let Some(job) = self.job.as_mut().filter(|j| j.phase == JobPhase::Aborting) else {
+            return;
+        };
+        job.record.state = JobState::Aborted;
+        job.phase = JobPhase::Aborted;
+        let (id, dir, record) = (job.info.id.clone(), job.dir.clone(), job.record.clone());
+        self.emit(Effect::SaveRecord { dir, record });
+        self.emit(Effect::StopPipeline);
+        self.publish(Event::JobAborted { job: id });
+    }
+
+    fn save_record(&mut self, job: &Job) {
+        self.emit(Effect::SaveRecord {
+            dir: job.dir.clone(),
+            record: job.record.clone(),
+        });
+    }
+
+    fn clear(&mut self, id: RequestId) {
+        if self.clearing.is_some() {
+            return self.refuse(id, "a clear is already in progress".into());
+        }
+        if self.preparing.is_some() {
+            return self.refuse(
+                id,
+                "a job is being set up: nothing moves until it starts; clear after it".into(),
+            );
+        }
+        if let Some(job) = self.job.as_ref() {
+            if matches!(
+                job.phase,
+                JobPhase::Running | JobPhase::Finishing | JobPhase::Aborting
+            ) {
+                let message = format!("job {} is {}: nothing to clear", job.info.id, job.phase);
+                return self.refuse(id, message);
+            }
+        }
+        self.clearing = Some(id);
+        let open = self.job.as_ref().filter(|j| !j.is_over());
+        let part = self.job.as_ref().and_then(|j| j.part_model.clone());
+        let cut: Vec<(String, KnownPath, f64)> =
+            open.map(|j| j.cut_paths.clone()).unwrap_or_default();
+        let mut orders = Vec::new();
+        for slot in &mut self.slots {
+            if matches!(slot.state, MachineState::Scanning { .. }) {
+                continue;
+            }
+            let escape = EscapeModel {
+                cut: cut
+                    .iter()
+                    .find(|(machine, _, _)| *machine == slot.name)
+                    .map(|(_, path, margin)| (path.clone(), *margin)),
+                part: part.clone(),
+            };
+            slot.state = MachineState::Clearing;
+            orders.push(Effect::Clear {
+                machine: slot.name.clone(),
+                escape,
+            });
+        }
+        self.effects.extend(orders);
+        self.resume_if_clear();
+    }
+
+    fn cleared(&mut self, machine: &str, result: Result<(), WorkerError>) {
+        if let Err(error) = &result {
+            tracing::error!(machine, error = %error, "clear failed");
+        }
+        if let Some(slot) = self.slot(machine) {
+            slot.state = match result {
+                Ok(()) => MachineState::Idle,
+                Err(error) => MachineState::LockedOut {
+                    fault: error.fault(),
+                },
+            };
+        }
+        // The cut scans' paths served their one way out.
+        if let Some(job) = self.job.as_mut() {
+            job.cut_paths.retain(|(m, _, _)| m != machine);
+        }
+        self.resume_if_clear();
+    }
+
+    /// When no machine is clearing any more: answer the operator, and resume a stopped job if all went well.
+    fn resume_if_clear(&mut self) {
+        if self.slots.iter().any(|s| s.state == MachineState::Clearing) {
+            return;
+        }
+        let Some(id) = self.clearing.take() else {
+            return;
+        };
+        let faults: Vec<String> = self
+            .slots
+            .iter()
+            .filter_map(|s| match &s.state {
+                MachineState::LockedOut {
+                    fault: MachineFault { kind, message },
+                } => Some(format!("{message} ({kind})")),
+                _ => None,
+            })
+            .collect();
+        if !faults.is_empty() {
+            return self.refuse(id, format!("not cleared: {}", faults.join("; ")));
+        }
+        let resumed = match self.job.as_mut() {
+            Some(job) if matches!(job.phase, JobPhase::Stopped { .. }) => {
+                job.phase = JobPhase::Running;
+                Some((job.info.clone(), job.done_refs()))
+            }
+            _ => None,
+        };
+        let message = match resumed {
+            Some((info, done)) => {
+                self.emit(Effect::StartPipeline);
+                self.publish(Event::JobStarted {
+                    job: info.clone(),
+                    done,
+                });
+                self.publish(Event::JobResumed {
+                    job: info.id.clone(),
+                });
+                format!(
+                    "machines clear; job {} continues from its last complete profile",
+                    info.id
+                )
+            }
+            None => "machines clear".to_string(),
+        };
+        self.reply(id, Reply::Done { message });
+    }
+
+    fn status(&self) -> StationStatus {
+        let machines = self
+            .slots
+            .iter()
+            .map(|slot| MachineStatus {
+                name: slot.name.clone(),
+                state: slot.state.clone(),
+            })
+            .collect();
+        let job = self.job.as_ref().map(|job| JobStatus {
+            job: job.info.clone(),
+            state: job.phase.clone(),
+            profiles_done: job.stored.len(),
+            profiles_total: job.total,
+        });
+        StationStatus {
+            station: self.station.clone(),
+            machines,
+            preparing: self.preparing.as_ref().map(|p| p.job.clone()),
+            job,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

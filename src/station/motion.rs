@@ -1,0 +1,165 @@
+//! The one motion plan of a job: each scan's moves (approach, descent, scan, lift-off, way out) built once as
+//! data. The clearance check sweeps these values and the worker sends these values, so the path proven safe and
+//! the path driven cannot drift apart.
+//!
+//! Positions are ball centres planned for the largest ball the station accepts (`[safety] max_ball_radius_mm`),
+//! the ball the clearance check sweeps: a smaller real ball at the same centres lies inside the swept one, only
+//! further off the surface.
+
+use nalgebra::{Point3, Vector3};
+
+use super::escape::{way_out, KnownPath};
+use crate::analysis::Reference;
+use crate::api::JobKind;
+use crate::config::Safety;
+use crate::plan::{Plan, ProfileKey};
+use zeroset_drivers::machine::{CurveScan, InPlaneScan};
+
+/// Teaching starts from a point of the drawing, not of the part: the probe enters this far above it, mm.
+const TEACH_MARGIN_MM: f64 = 5.0;
+/// Inspecting follows the taught curve; the real surface lies within the expected deviation of it, so the probe
+/// keeps this much more off it when entering and leaving, mm.
+const INSPECT_EXTRA_MARGIN_MM: f64 = 2.0;
+/// How far beyond the margin the ball may end a scan from its planned end and still take the planned lift-off:
+/// the machine's own retract after the scan and the real ball being smaller than the planned one, mm.
+const END_TOLERANCE_MM: f64 = 3.0;
+
+/// The scan command itself.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Scan {
+    /// The master's profile, shape unknown.
+    InPlane(InPlaneScan),
+    /// A profile along its taught nominal curve.
+    Curve(CurveScan),
+}
+
+/// Every move of one profile's scan, machine coordinates, ball centres, mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScanMotion {
+    pub key: ProfileKey,
+    /// The part, instance and profile, as the operator reads them.
+    pub name: String,
+    /// Above the entry at the clearance height, then straight down to the entry.
+    pub approach: [Point3<f64>; 2],
+    pub scan: Scan,
+    /// The surface known before the scan, and its entry: what a way out after a stop follows.
+    pub path: KnownPath,
+    /// How far off the known surface the ball travels when entering and leaving, mm.
+    pub margin_mm: f64,
+    /// Where the ball is planned to stop when the scan ends, and how far from it a real end may lie for the
+    /// lift-off to be the planned one (beyond it the worker refuses and waits for `zeroset clear`).
+    pub end: Point3<f64>,
+    pub end_tolerance_mm: f64,
+    /// From the end: the lift-off off the surface, along the path back to the entry, and up.
+    pub retract: Vec<Point3<f64>>,
+    /// The ball radius these positions are planned for, mm.
+    pub ball_radius_mm: f64,
+}
+
+/// Why a scan's motion cannot be planned.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{scan}: {problem}")]
+pub struct PlanError {
+    pub scan: String,
+    pub problem: String,
+}
+
+/// How far the probe keeps off the known surface when entering and leaving a scan of a job of `kind`, mm.
+pub(super) fn scan_margin_mm(plan: &Plan, kind: JobKind) -> f64 {
+    match kind {
+        JobKind::Teach => TEACH_MARGIN_MM,
+        JobKind::Inspect => plan.scan_settings().max_deviation_mm + INSPECT_EXTRA_MARGIN_MM,
+    }
+}
+
+/// The motion of one scan: a curve scan along the reference's nominals when there is one, else the teach's
+/// in-plane scan from the part file's start point.
+pub fn scan_motion(
+    plan: &Plan,
+    reference: Option<&Reference>,
+    key: ProfileKey,
+    safety: &Safety,
+) -> Result<ScanMotion, PlanError> {
+    let name = format!("part {}, {}", plan.part(), plan.describe(key));
+    let (scan, path, kind) = match reference {
+        Some(reference) => {
+            let scan = plan.curve_scan(key, &reference.profiles[key.profile].nominals);
+            let path = KnownPath::of_curve_scan(&scan);
+            (Scan::Curve(scan), path, JobKind::Inspect)
+        }
+        None => {
+            let scan = plan.in_plane_scan(key);
+            let start = Point3::new(scan.start.x, scan.start.y, scan.start.z);
+            let normal = Vector3::new(
+                scan.start_normal.x,
+                scan.start_normal.y,
+                scan.start_normal.z,
+            );
+            let path = KnownPath {
+                surface: vec![start],
+                normals: vec![normal.try_normalize(1e-12).unwrap_or_default()],
+                closed: false,
+                entry: 0,
+            };
+            (Scan::InPlane(scan), path, JobKind::Teach)
+        }
+    };
+    ScanMotion::plan(key, name, scan, path, scan_margin_mm(plan, kind), safety)
+}
+
+impl ScanMotion {
+    /// The moves of a scan over `path`, entered from above its entry: down from the clearance height to `margin`
+    /// off the surface beyond the planned ball, and after the scan off the surface and back up the same way.
+    pub fn plan(
+        key: ProfileKey,
+        name: String,
+        scan: Scan,
+        path: KnownPath,
+        margin: f64,
+        safety: &Safety,
+    ) -> Result<ScanMotion, PlanError> {
+        let fail = |problem: String| PlanError {
+            scan: name.clone(),
+            problem,
+        };
+        path.validate().map_err(fail)?;
+        let radius = safety.max_ball_radius_mm;
+        let entry = path.entry_offset(radius, margin);
+        if entry.z >= safety.clearance_z_mm {
+            return Err(fail(format!(
+                "its entry ({:.3}, {:.3}, {:.3}) mm is not below the clearance height z = {} mm ([safety] \
+                 clearance_z_mm): the clearance height must lie above the part",
+                entry.x, entry.y, entry.z, safety.clearance_z_mm
+            )));
+        }
+        let above = Point3::new(entry.x, entry.y, safety.clearance_z_mm);
+        // A closed profile ends where it began; the teach's in-plane scan closes at its start point too.
+        let end = path.surface[path.entry] + path.normals[path.entry] * radius;
+        let retract = way_out(end, Some(&path), radius, margin, safety.clearance_z_mm)
+            .map_err(|e| fail(e.to_string()))?;
+        Ok(ScanMotion {
+            key,
+            name,
+            approach: [above, entry],
+            scan,
+            path,
+            margin_mm: margin,
+            end,
+            end_tolerance_mm: margin + END_TOLERANCE_MM,
+            retract,
+            ball_radius_mm: radius,
+        })
+    }
+}
+
+/// The motion of every scan in `keys`, in their order.
+pub fn job_motions(
+    plan: &Plan,
+    reference: Option<&Reference>,
+    keys: &[ProfileKey],
+    safety: &Safety,
+) -> Result<Vec<ScanMotion>, PlanError> {
+    keys.iter()
+        .map(|&key| scan_motion(plan, reference, key, safety))
+        .collect()
+}
