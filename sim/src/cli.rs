@@ -9,9 +9,9 @@ use crate::config::SimConfig;
 
 /// Simulated coordinate measuring machines speaking I++ DME on pseudo-terminals or loopback TCP.
 ///
-/// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT, SIGTERM or the end of standard
-/// input. Lines `fault MACHINE KIND [ARG]` on standard input inject faults: garbage, drop-lines N, delay MS,
-/// disconnect MS, estop, collision, no-touch, surface-not-found.
+/// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT or SIGTERM (the end of standard
+/// input does not stop it, so it can run in the background). Lines `fault MACHINE KIND [ARG]` on standard input
+/// inject faults: garbage, drop-lines N, delay MS, disconnect MS, estop, collision, no-touch, surface-not-found.
 #[derive(Debug, Args)]
 pub struct SimArgs {
     /// The simulator's configuration, e.g. config/sims/propeller.toml.
@@ -44,8 +44,8 @@ pub fn run(args: &SimArgs) -> anyhow::Result<()> {
         args.time_scale,
         args.link_dir.as_deref(),
     ));
-    // Standard input is read on a blocking thread that no signal interrupts: waiting for it (what dropping the
-    // runtime does) would keep a simulator told to stop by SIGTERM alive until its stdin closes.
+    // Standard input, while open, is read on a blocking thread that no signal interrupts: waiting for it (what
+    // dropping the runtime does) would keep a simulator told to stop by SIGTERM alive until its stdin closes.
     runtime.shutdown_background();
     served?;
     Ok(())

@@ -1,8 +1,8 @@
 //! The whole simulator: opens every configured machine's line, links each pseudo-terminal into the link
 //! folder if one is given, prints `machine NAME PATH` for each, then serves them (one task per machine)
-//! until SIGINT, SIGTERM or the end of standard input. Standard input is also the fault channel:
-//! `fault MACHINE KIND [ARG]` per line (see faults.rs), answered on standard output with
-//! `ok fault MACHINE KIND` or `error: WHY`.
+//! until SIGINT or SIGTERM. Standard input, while open, is the fault channel: `fault MACHINE KIND [ARG]`
+//! per line (see faults.rs), answered on standard output with `ok fault MACHINE KIND` or `error: WHY`.
+//! Its end (or no standard input at all) leaves the machines serving, with only the configured faults.
 
 use std::collections::HashMap;
 use std::io::{self, Write};
@@ -100,12 +100,27 @@ pub async fn run(
     print_flushed(&announce)?;
 
     let mut stdin = BufReader::new(tokio::io::stdin()).lines();
+    // A simulator started in the background (`zeroset sim ... &`, stdin /dev/null or closed) must keep
+    // serving: the end of standard input only ends the fault channel, and only a signal stops the machines.
+    let mut stdin_open = true;
     loop {
         tokio::select! {
             _ = terminate.recv() => break,
             _ = interrupt.recv() => break,
-            line = stdin.next_line() => {
-                let Some(line) = line? else { break };
+            line = stdin.next_line(), if stdin_open => {
+                let line = match line {
+                    Ok(Some(line)) => line,
+                    Ok(None) => {
+                        stdin_open = false;
+                        continue;
+                    }
+                    Err(e) => {
+                        // Not fatal either: the machines do not need the fault channel.
+                        eprintln!("zeroset-sim: standard input: {e}; only configured faults from now on");
+                        stdin_open = false;
+                        continue;
+                    }
+                };
                 if line.trim().is_empty() {
                     continue;
                 }

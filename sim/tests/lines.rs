@@ -125,7 +125,25 @@ fn configuration_errors_name_the_key_and_the_file() {
 #[test]
 fn sigterm_stops_the_simulator() {
     let sim = Sim::start(&config_path("propeller.toml"), 100.0);
-    let pid = nix::unistd::Pid::from_raw(sim.pid() as i32);
-    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).unwrap();
-    assert!(sim.wait().success());
+    assert!(sim.stop().success());
+}
+
+#[test]
+fn the_simulator_keeps_serving_without_standard_input() {
+    // `zeroset sim ... &` in a script: standard input is /dev/null, read to its end at once.
+    let mut sim = Sim::start_without_stdin(&config_path("propeller.toml"), 100.0);
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        sim.running(),
+        "the simulator exited at the end of its stdin"
+    );
+    let mut client = Client::open(sim.path("cmm1"));
+    client.ready();
+    assert_eq!(
+        client.transact("00004 GetDMEVersion()")[1],
+        "00004 # DMEVersion(\"1.4.3\")"
+    );
+    drop(client);
+    assert!(sim.running());
+    assert!(sim.stop().success());
 }

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use clap::Args;
 
+use crate::fsutil::write_atomically;
 use crate::geometry::supershape::mesh::{polygonise, MeshFormat, MeshParams};
 use crate::model_file::{ModelFile, ReferenceModel};
 
@@ -47,7 +48,10 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
         ..MeshParams::with_cell(cell)
     };
     let mesh = polygonise(solid, &params)?;
-    mesh.write(&args.out, format)?;
+    let mut bytes = Vec::new();
+    mesh.write_to(&mut bytes, format)?;
+    // Atomically, so that a reader (a slicer, a viewer) never sees half a mesh.
+    write_atomically(&args.out, &bytes)?;
     println!(
         "wrote {}: {} vertices, {} triangles, {}, volume {:.3} mm^3, area {:.3} mm^2, cell {cell:.3} mm, every vertex \
          within |F| < {:e} ({:.2} s)",

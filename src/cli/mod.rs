@@ -60,9 +60,10 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Run the simulated CMMs of a simulator configuration (the same as the zeroset-sim binary).
     ///
-    /// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT, SIGTERM or the end of
-    /// standard input. Lines `fault MACHINE KIND [ARG]` on standard input inject faults: garbage, drop-lines N,
-    /// delay MS, disconnect MS, estop, collision, no-touch, surface-not-found.
+    /// Prints `machine NAME PATH` per machine when ready, then runs until SIGINT or SIGTERM (the end of standard
+    /// input does not stop it, so it can run in the background). Lines `fault MACHINE KIND [ARG]` on standard
+    /// input inject faults: garbage, drop-lines N, delay MS, disconnect MS, estop, collision, no-touch,
+    /// surface-not-found.
     Sim(zeroset_sim::cli::SimArgs),
 }
 

@@ -23,17 +23,15 @@ pub struct Number {
 impl Number {
     /// The shortest text that reads back as `value`, written without an exponent when that fits in 16
     /// digits (`123.456`, `0.001`, `-90`), with one otherwise (`1.5E-20`). A value that needs 17
-    /// significant digits is rounded to 16, a relative change below 1e-15, far under any CMM's resolution.
+    /// significant digits is rounded to 16 (cut to 16 next to `f64::MAX`, where rounding up would pass
+    /// it), a relative change below 1e-15, far under any CMM's resolution. NaN and infinities are
+    /// refused; every number returned is one the wire parser reads back, finite.
     pub fn from_f64(value: f64) -> Result<Self, WireError> {
         if !value.is_finite() {
             return Err(WireError::NonFiniteNumber);
         }
-        let text = format_f64(value);
-        let value = text.parse().expect("format_f64 writes a valid f64 literal");
-        Ok(Number {
-            text: text.into(),
-            value,
-        })
+        // Through the parser, so that a text it would refuse can never be sent.
+        format_f64(value).parse()
     }
 
     /// The value (always finite).
@@ -129,8 +127,20 @@ fn format_f64(value: f64) -> String {
     }
     // `{:e}` gives the shortest digits that read back as `value`; past 16 of them, round to 16.
     let mut scientific = format!("{value:e}");
-    if significant_digits(&scientific) > MAX_DIGITS {
-        scientific = format!("{:.*e}", MAX_DIGITS - 1, value);
+    let shortest_digits = significant_digits(&scientific);
+    if shortest_digits > MAX_DIGITS {
+        let rounded = format!("{:.*e}", MAX_DIGITS - 1, value);
+        scientific = if rounded.parse::<f64>().is_ok_and(f64::is_finite) {
+            rounded
+        } else {
+            // Within half a 16-digit step of f64::MAX, rounding up gives 1.797693134862316E308, which
+            // reads back as infinity; the digits cut to 16 are the nearest finite text.
+            let (mantissa, exponent) = scientific
+                .split_once('e')
+                .expect("`{:e}` writes an exponent");
+            let cut = mantissa.len() - (shortest_digits - MAX_DIGITS);
+            format!("{}e{exponent}", &mantissa[..cut])
+        };
     }
     let (mantissa, exponent) = scientific
         .split_once('e')
@@ -178,6 +188,7 @@ fn significant_digits(scientific: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     fn text_of(value: f64) -> String {
         Number::from_f64(value).unwrap().to_string()
@@ -211,6 +222,64 @@ mod tests {
         let number = Number::from_f64(sum).unwrap();
         assert_eq!(number.as_str(), "0.3");
         assert!((number.value() - sum).abs() <= sum * 1e-15);
+    }
+
+    #[test]
+    fn the_extremes_read_back_finite() {
+        let largest_subnormal = f64::from_bits(f64::MIN_POSITIVE.to_bits() - 1);
+        let below_max = f64::from_bits(f64::MAX.to_bits() - 1);
+        for (value, text) in [
+            (f64::MAX, "1.797693134862315E308"),
+            (-f64::MAX, "-1.797693134862315E308"),
+            (below_max, "1.797693134862315E308"),
+            (f64::MIN_POSITIVE, "2.225073858507201E-308"),
+            (-f64::MIN_POSITIVE, "-2.225073858507201E-308"),
+            (largest_subnormal, "2.225073858507201E-308"),
+            (5e-324, "5E-324"),
+            (-5e-324, "-5E-324"),
+            (1e-310, "1E-310"),
+        ] {
+            let number = Number::from_f64(value).unwrap_or_else(|e| panic!("{value:e}: {e}"));
+            assert_eq!(number.as_str(), text, "{value:e}");
+            let read: Number = number.as_str().parse().unwrap();
+            assert!(read.value().is_finite(), "{value:e}");
+            assert_eq!(read.value(), number.value(), "{value:e}");
+            assert!(
+                (number.value() - value).abs() <= value.abs() * 1e-15,
+                "{value:e} read back as {:e}",
+                number.value()
+            );
+        }
+        // MIN_POSITIVE's 16-digit text is nearer the largest subnormal: the nearest value to the text.
+        assert_eq!(
+            Number::from_f64(f64::MIN_POSITIVE).unwrap().value(),
+            largest_subnormal
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn every_finite_value_reads_back_through_the_parser(
+            // Any bits, and more often the ends of the range: the values next to f64::MAX and the subnormals.
+            magnitude in prop_oneof![
+                any::<u64>(),
+                (f64::MAX.to_bits() - 16)..=f64::MAX.to_bits(),
+                0..f64::MIN_POSITIVE.to_bits() + 4096,
+            ],
+            negative in any::<bool>(),
+        ) {
+            let value = f64::from_bits(magnitude).copysign(if negative { -1.0 } else { 1.0 });
+            prop_assume!(value.is_finite());
+            let number = Number::from_f64(value).unwrap();
+            let read: Number = number.as_str().parse().unwrap();
+            prop_assert!(read.value().is_finite());
+            prop_assert_eq!(read.value(), number.value());
+            if significant_digits(&format!("{value:e}")) <= MAX_DIGITS {
+                prop_assert_eq!(number.value(), value);
+            } else {
+                prop_assert!((number.value() - value).abs() <= value.abs() * 1e-15);
+            }
+        }
     }
 
     #[test]

@@ -42,14 +42,24 @@ pub struct Sim {
 }
 
 impl Sim {
+    /// Starts the simulator with a pipe on its standard input, for [`Sim::control`].
     pub fn start(config: &Path, time_scale: f64) -> Sim {
+        Sim::launch(config, time_scale, Stdio::piped())
+    }
+
+    /// Starts the simulator with `/dev/null` as standard input, as a shell starts a background job.
+    pub fn start_without_stdin(config: &Path, time_scale: f64) -> Sim {
+        Sim::launch(config, time_scale, Stdio::null())
+    }
+
+    fn launch(config: &Path, time_scale: f64, stdin: Stdio) -> Sim {
         let expected = SimConfig::load(config).unwrap().machines.len();
         let mut child = Command::new(env!("CARGO_BIN_EXE_zeroset-sim"))
             .arg("--config")
             .arg(config)
             .arg("--time-scale")
             .arg(time_scale.to_string())
-            .stdin(Stdio::piped())
+            .stdin(stdin)
             .stdout(Stdio::piped())
             .spawn()
             .expect("the simulator starts");
@@ -93,9 +103,15 @@ impl Sim {
         self.child.id()
     }
 
-    /// Closes standard input and returns the exit status.
-    pub fn stop(mut self) -> std::process::ExitStatus {
-        drop(self.stdin.take());
+    /// Whether the process is still running.
+    pub fn running(&mut self) -> bool {
+        self.child.try_wait().unwrap().is_none()
+    }
+
+    /// Sends SIGTERM and returns the exit status.
+    pub fn stop(self) -> std::process::ExitStatus {
+        let pid = nix::unistd::Pid::from_raw(self.pid() as i32);
+        nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).unwrap();
         self.wait()
     }
 

@@ -1,9 +1,9 @@
-//! Mesh files: binary STL (stl_io), binary little-endian PLY (ply-rs-bw) and Wavefront OBJ (a few
+//! Mesh encodings: binary STL (stl_io), binary little-endian PLY (ply-rs-bw) and Wavefront OBJ (a few
 //! lines of text, no crate needed). Coordinates are millimetres; PLY and OBJ say so in a comment,
-//! binary STL in its free-text 80-byte header. Each file is built in memory and written atomically
-//! (temporary name beside it, then a rename), so a reader never sees half a mesh.
+//! binary STL in its free-text 80-byte header. The kernel does no file I/O: meshes are written to any
+//! `io::Write`, and the caller owns the file (the CLI writes it atomically).
 
-use std::fmt::Write as _;
+use std::io::Write;
 use std::path::Path;
 
 use ply_rs_bw::ply::{
@@ -13,7 +13,6 @@ use ply_rs_bw::ply::{
 
 use super::trimesh::TriMesh;
 use super::MeshError;
-use crate::fsutil::write_atomically;
 
 /// The mesh file formats the station writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,19 +42,18 @@ impl MeshFormat {
 }
 
 impl TriMesh {
-    /// Writes the mesh to `path` in `format`, atomically.
-    pub fn write(&self, path: &Path, format: MeshFormat) -> Result<(), MeshError> {
-        let bytes = match format {
-            MeshFormat::Stl => self.stl_bytes()?,
-            MeshFormat::Ply => self.ply_bytes()?,
-            MeshFormat::Obj => self.obj_text().into_bytes(),
-        };
-        write_atomically(path, &bytes).map_err(MeshError::Io)
+    /// Writes the mesh to `out` in `format` (many small writes for OBJ: buffer a slow `out`).
+    pub fn write_to<W: Write>(&self, out: &mut W, format: MeshFormat) -> Result<(), MeshError> {
+        match format {
+            MeshFormat::Stl => self.write_stl(out),
+            MeshFormat::Ply => self.write_ply(out),
+            MeshFormat::Obj => self.write_obj(out),
+        }
     }
 
     /// Binary STL: single-precision triangles with their unit normals (the format holds no shared
     /// vertices and no better precision).
-    fn stl_bytes(&self) -> Result<Vec<u8>, MeshError> {
+    fn write_stl<W: Write>(&self, out: &mut W) -> Result<(), MeshError> {
         let triangles: Vec<stl_io::Triangle> = self
             .triangles
             .iter()
@@ -76,16 +74,18 @@ impl TriMesh {
                 }
             })
             .collect();
+        // Built in memory because stl_io writes a blank header, replaced here by free text that must not
+        // start with "solid" (the ASCII format's keyword).
         let mut bytes = Vec::new();
-        stl_io::write_stl(&mut bytes, triangles.iter()).map_err(MeshError::Io)?;
-        // The header is free text that must not start with "solid" (the ASCII format's keyword).
+        stl_io::write_stl(&mut bytes, triangles.iter())?;
         let header = format!("binary STL from zeroset, {UNITS}");
         bytes[..header.len()].copy_from_slice(header.as_bytes());
-        Ok(bytes)
+        out.write_all(&bytes)?;
+        Ok(())
     }
 
     /// Binary little-endian PLY with double-precision vertices and triangle index lists.
-    fn ply_bytes(&self) -> Result<Vec<u8>, MeshError> {
+    fn write_ply<W: Write>(&self, out: &mut W) -> Result<(), MeshError> {
         let mut ply = Ply::<DefaultElement>::new();
         ply.header.encoding = Encoding::BinaryLittleEndian;
         ply.header.comments.push(UNITS.to_string());
@@ -125,25 +125,21 @@ impl TriMesh {
             .collect();
         ply.payload.insert("vertex".to_string(), vertices);
         ply.payload.insert("face".to_string(), faces);
-        let mut bytes = Vec::new();
-        ply_rs_bw::writer::Writer::new()
-            .write_ply(&mut bytes, &mut ply)
-            .map_err(MeshError::Io)?;
-        Ok(bytes)
+        ply_rs_bw::writer::Writer::new().write_ply(out, &mut ply)?;
+        Ok(())
     }
 
     /// Wavefront OBJ: `v x y z` with the shortest decimal that reads back to the same double,
     /// `f a b c` with 1-based indices.
-    fn obj_text(&self) -> String {
-        let mut text = format!("# zeroset mesh, {UNITS}\n");
+    fn write_obj<W: Write>(&self, out: &mut W) -> Result<(), MeshError> {
+        writeln!(out, "# zeroset mesh, {UNITS}")?;
         for p in &self.vertices {
-            // Writing to a String cannot fail.
-            let _ = writeln!(text, "v {} {} {}", p.x, p.y, p.z);
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
         }
         for t in &self.triangles {
-            let _ = writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+            writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
         }
-        text
+        Ok(())
     }
 }
 
@@ -155,7 +151,6 @@ mod tests {
     use crate::geometry::supershape::deform::{Deformation, Deformations};
     use crate::geometry::supershape::shape::Supershape;
     use nalgebra::Point3;
-    use std::path::PathBuf;
 
     fn ellipsoid_mesh() -> TriMesh {
         let solid = Solid::new(Node::supershape(
@@ -188,8 +183,10 @@ mod tests {
         mesh
     }
 
-    fn path_in(dir: &tempfile::TempDir, name: &str) -> PathBuf {
-        dir.path().join(name)
+    fn encoded(mesh: &TriMesh, format: MeshFormat) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        mesh.write_to(&mut bytes, format).unwrap();
+        bytes
     }
 
     #[test]
@@ -215,25 +212,17 @@ mod tests {
     #[test]
     fn obj_reads_back_exactly() {
         let mesh = ellipsoid_mesh();
-        let dir = tempfile::tempdir().unwrap();
-        let path = path_in(&dir, "part.obj");
-        mesh.write(&path, MeshFormat::from_path(&path).unwrap())
-            .unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
+        let text = String::from_utf8(encoded(&mesh, MeshFormat::Obj)).unwrap();
         assert!(text.starts_with("# zeroset mesh, units: mm"));
         assert_eq!(read_obj(&text), mesh);
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]
     fn ply_reads_back_exactly() {
         let mesh = ellipsoid_mesh();
-        let dir = tempfile::tempdir().unwrap();
-        let path = path_in(&dir, "part.ply");
-        mesh.write(&path, MeshFormat::Ply).unwrap();
-        let mut file = std::fs::File::open(&path).unwrap();
+        let bytes = encoded(&mesh, MeshFormat::Ply);
         let ply = ply_rs_bw::parser::Parser::<DefaultElement>::new()
-            .read_ply(&mut file)
+            .read_ply(&mut bytes.as_slice())
             .unwrap();
         assert_eq!(ply.header.comments, vec![UNITS.to_string()]);
         let coordinate = |e: &DefaultElement, name: &str| match e[name] {
@@ -263,10 +252,7 @@ mod tests {
     #[test]
     fn stl_reads_back_to_single_precision() {
         let mesh = ellipsoid_mesh();
-        let dir = tempfile::tempdir().unwrap();
-        let path = path_in(&dir, "part.stl");
-        mesh.write(&path, MeshFormat::Stl).unwrap();
-        let bytes = std::fs::read(&path).unwrap();
+        let bytes = encoded(&mesh, MeshFormat::Stl);
         assert!(bytes.starts_with(b"binary STL from zeroset, units: mm"));
         let read = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).unwrap();
         assert_eq!(read.faces.len(), mesh.triangles.len());
