@@ -630,6 +630,11 @@ impl Core {
         self.clearing = Some(id);
         let open = self.job.as_ref().filter(|j| !j.is_over());
         let part = self.job.as_ref().and_then(|j| j.part_model.clone());
+        let deviation_margin_mm = self
+            .job
+            .as_ref()
+            .and_then(|j| j.motions.values().next())
+            .map_or(0.0, |m| m.margin_mm);
         let cut: Vec<(String, KnownPath, f64)> =
             open.map(|j| j.cut_paths.clone()).unwrap_or_default();
         let mut orders = Vec::new();
@@ -643,6 +648,7 @@ impl Core {
                     .find(|(machine, _, _)| *machine == slot.name)
                     .map(|(_, path, margin)| (path.clone(), *margin)),
                 part: part.clone(),
+                deviation_margin_mm,
             };
             slot.state = MachineState::Clearing;
             orders.push(Effect::Clear {

@@ -57,6 +57,8 @@ pub struct EscapeModel {
     pub cut: Option<(KnownPath, f64)>,
     /// The taught part on the machine, every instance (none when teaching: then only the known path counts).
     pub part: Option<Arc<MeshPart>>,
+    /// How far the real part may lie from the model, and then some: the job's scan margin, mm.
+    pub deviation_margin_mm: f64,
 }
 
 /// Waypoints between consecutive points of the way out are at most this far apart, mm, and closer where the
@@ -66,6 +68,9 @@ const WAYPOINT_TURN_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
 /// How far the ball may be from the known path's centre positions (plus the margin) and still be on it: the
 /// retract after a scan and the points measured after the last one recorded.
 const ON_PATH_TOLERANCE_MM: f64 = 3.0;
+/// How far from the vertical over a scan's entry the ball may be and still be on its descent (or its final rise):
+/// the difference between the planned ball and the real one, mm.
+const ON_DESCENT_TOLERANCE_MM: f64 = 0.5;
 
 impl KnownPath {
     /// The nominal curve of a curve scan, entered at its first nominal (the plan puts the entry there).
@@ -152,6 +157,24 @@ pub fn way_out(
     let Some(path) = path.filter(|p| !p.surface.is_empty()) else {
         return Err(EscapeError::Unknown(position));
     };
+    // Over the entry, on the vertical the scan is entered and left by: straight up the way it came.
+    let exit = path.entry_offset(ball_radius, margin);
+    let over_entry = (position.xy() - exit.xy()).norm() <= ON_DESCENT_TOLERANCE_MM
+        && position.z >= exit.z - ON_DESCENT_TOLERANCE_MM;
+    if over_entry {
+        return Ok(vec![Point3::new(position.x, position.y, clearance_z)]);
+    }
+    // On the entry's normal beyond the ball's contact: where a scan's own approach stops (a curve scan moves out
+    // along the first nominal's normal by the expected deviation and the search distance before it probes).
+    let along_normal = (position - path.surface[path.entry]).dot(&path.normals[path.entry]);
+    let on_entry_normal = along_normal >= ball_radius
+        && (path.surface[path.entry] + path.normals[path.entry] * along_normal - position).norm()
+            <= ON_DESCENT_TOLERANCE_MM;
+    if on_entry_normal {
+        let mut moves = vec![exit, Point3::new(exit.x, exit.y, clearance_z.max(exit.z))];
+        moves.dedup_by(|b, a| (*b - *a).norm() < 1e-9);
+        return Ok(moves);
+    }
     let foot = nearest_on_path(path, &position);
     if foot.distance > ball_radius + margin + ON_PATH_TOLERANCE_MM {
         return Err(EscapeError::OffPath {
@@ -219,7 +242,10 @@ pub fn plan_escape(
         Some((path, margin)) => (Some(path), margin),
         None => (None, 0.0),
     };
-    let moves = way_out(position, known, ball_radius, margin, safety.clearance_z_mm)?;
+    let moves = match way_out(position, known, ball_radius, margin, safety.clearance_z_mm) {
+        Ok(moves) => moves,
+        Err(error) => return straight_up_if_free(position, ball_radius, safety, model, error),
+    };
     let wanted = safety.move_margin_mm;
     let mut from = position;
     for (leg, &to) in moves.iter().enumerate() {
@@ -235,7 +261,7 @@ pub fn plan_escape(
             // The mesh lies within its chord tolerance of the model: a lift-off may seem to dip by as much.
             against.push((
                 "the taught part model",
-                start + part.chord_tolerance_mm(),
+                start - part.chord_tolerance_mm(),
                 least,
             ));
         }
@@ -258,6 +284,29 @@ pub fn plan_escape(
         from = to;
     }
     Ok(moves)
+}
+
+/// Off every known path, the one way out that can still be proven: straight up, if the taught model says the
+/// ball stays clear of it all the way by the job's deviation margin (the real part lies within the expected
+/// deviation of the model, and the margin is that plus 2 mm). Otherwise `error`: nothing moves.
+fn straight_up_if_free(
+    position: Point3<f64>,
+    ball_radius: f64,
+    safety: &Safety,
+    model: &EscapeModel,
+    error: EscapeError,
+) -> Result<Vec<Point3<f64>>, EscapeError> {
+    let Some(part) = model.part.as_deref() else {
+        return Err(error);
+    };
+    let top = Point3::new(position.x, position.y, safety.clearance_z_mm);
+    let needed = model.deviation_margin_mm.max(safety.move_margin_mm) + part.chord_tolerance_mm();
+    let least = ball_clearance(part, &position, &top, ball_radius, needed);
+    if least >= needed {
+        Ok(vec![top])
+    } else {
+        Err(error)
+    }
 }
 
 /// The least clearance (mm) of a ball moved straight from `a` to `b` against `part`, by conservative advancement
@@ -378,86 +427,4 @@ fn walk(from: usize, to: usize, len: usize, closed: bool) -> Vec<usize> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A circle of radius 20 mm in the plane x = 100, centre at z = 0, scanned from its top.
-    fn circle(closed_points: usize) -> KnownPath {
-        let (surface, normals) = (0..closed_points)
-            .map(|k| {
-                let t = std::f64::consts::FRAC_PI_2
-                    + std::f64::consts::TAU * k as f64 / closed_points as f64;
-                let n = Vector3::new(0.0, t.cos(), t.sin());
-                (Point3::new(100.0, 0.0, 0.0) + n * 20.0, n)
-            })
-            .unzip();
-        KnownPath {
-            surface,
-            normals,
-            closed: true,
-            entry: 0,
-        }
-    }
-
-    #[test]
-    fn above_the_clearance_height_nothing_moves() {
-        let moves = way_out(Point3::new(0.0, 0.0, 200.0), None, 1.0, 2.0, 150.0).unwrap();
-        assert!(moves.is_empty());
-    }
-
-    #[test]
-    fn under_the_part_the_way_out_goes_round_it_never_through() {
-        let path = circle(360);
-        // The ball touches the bottom of the circle: straight up would cross the part.
-        let position = Point3::new(100.0, 0.0, -21.0);
-        let moves = way_out(position, Some(&path), 1.0, 2.0, 150.0).unwrap();
-        let last = moves.last().unwrap();
-        assert_eq!(last.z, 150.0);
-        assert!(
-            (last.y).abs() < 1e-9 && (last.x - 100.0).abs() < 1e-9,
-            "{last}"
-        );
-        // Every straight move keeps the ball (radius 1) clear of the circle (radius 20).
-        let mut from = position;
-        for to in &moves {
-            for k in 0..=100 {
-                let p = from + (to - from) * (k as f64 / 100.0);
-                let clearance = ((p.y).powi(2) + (p.z).powi(2)).sqrt() - 20.0 - 1.0;
-                assert!(
-                    clearance > -1e-9,
-                    "the move {from} -> {to} cuts the part at {p}"
-                );
-            }
-            from = *to;
-        }
-        // Half way round one way: about 180 degrees / 10 degrees per waypoint at least.
-        assert!(moves.len() >= 18, "{} moves", moves.len());
-    }
-
-    #[test]
-    fn an_open_path_is_followed_back_to_its_entry() {
-        let mut path = circle(360);
-        path.surface.truncate(200);
-        path.normals.truncate(200);
-        path.closed = false;
-        let end = path.surface[199] + path.normals[199] * 1.0;
-        let moves = way_out(end, Some(&path), 1.0, 2.0, 150.0).unwrap();
-        // Backwards through the 200 scanned degrees (y < 0, counter-clockwise from the top), not forwards through
-        // the unknown 160.
-        let middle = moves[moves.len() / 2];
-        assert!(middle.y < 0.0, "goes back over the scanned side: {middle}");
-    }
-
-    #[test]
-    fn far_from_the_known_path_or_without_one_it_refuses() {
-        let path = circle(36);
-        let err =
-            way_out(Point3::new(100.0, 0.0, -40.0), Some(&path), 1.0, 2.0, 150.0).unwrap_err();
-        assert!(matches!(err, EscapeError::OffPath { .. }), "{err}");
-        let err = way_out(Point3::new(1.0, 2.0, 3.0), None, 1.0, 2.0, 150.0).unwrap_err();
-        assert!(
-            err.to_string().contains("below the clearance height"),
-            "{err}"
-        );
-    }
-}
+mod tests;

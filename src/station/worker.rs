@@ -413,11 +413,11 @@ impl Worker {
         let (client, radius) = self.prepare().await?;
         self.require_clearance_height(&client, &format!("the approach to {}", motion.name))
             .await?;
+        // From the descent on, the probe is near the part: a way out after a stop follows this scan's path.
+        self.path = Some((motion.path.clone(), motion.margin_mm));
         for target in &motion.approach {
             client.go_to(xyz(target)).await?;
         }
-        // From the entry on, the probe is near the part: a way out after a stop follows this scan's path.
-        self.path = Some((motion.path.clone(), motion.margin_mm));
         let scanning = client.scanning().ok_or_else(|| WorkerError {
             kind: FaultKind::Refused,
             message: format!(

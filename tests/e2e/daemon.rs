@@ -32,6 +32,16 @@ impl Station {
     /// The simulator of config/sims/`sim_config` and a daemon set up as config/`station_config`, its machines
     /// those of the simulator.
     pub fn start_as(sim_config: &str, station_config: &str) -> Station {
+        Station::start_edited(sim_config, station_config, |_| {})
+    }
+
+    /// Like [`Station::start_as`], with the station file changed by `edit` before the daemon reads it (e.g.
+    /// shorter timeouts).
+    pub fn start_edited(
+        sim_config: &str,
+        station_config: &str,
+        edit: impl FnOnce(&mut toml::Table),
+    ) -> Station {
         let root = tempfile::tempdir().expect("a temporary folder");
         let ports = root.path().join("ports");
         let sim = Sim::start_linked(sim_config, &ports);
@@ -42,6 +52,9 @@ impl Station {
             root.path(),
         )
         .expect("a station file");
+        let mut table: toml::Table = toml::from_str(&text).expect("the station file is TOML");
+        edit(&mut table);
+        let text = toml::to_string(&table).expect("TOML");
         let station_file = root.path().join("station.toml");
         std::fs::write(&station_file, text).expect("the station file is written");
         let mut station = Station {

@@ -4,6 +4,7 @@
 mod daemon;
 mod errors;
 mod fit_and_deviate;
+mod lockout;
 mod machine_link;
 mod nut;
 mod readme;

@@ -94,6 +94,11 @@ impl Sim {
         answer.trim().to_string()
     }
 
+    /// The transcript of a machine's line (the simulator's default: zeroset-sim-MACHINE-PID.log in the temp dir).
+    pub fn transcript(&self, machine: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("zeroset-sim-{machine}-{}.log", self.child.id()))
+    }
+
     /// The station's client on a machine's pseudo-terminal.
     pub fn client(&self, machine: &str, config: ClientConfig) -> Client {
         let port = open_pty(self.path(machine)).expect("the pty opens");

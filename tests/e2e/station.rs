@@ -487,7 +487,7 @@ fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
 }
 
 #[test]
-fn an_abort_stops_the_job_and_frees_the_station_for_the_next() {
+fn an_abort_stops_the_job_and_after_clear_the_station_takes_the_next() {
     let station = Station::start("propeller.toml").with_taught_reference();
     let mut watcher = station.watch();
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-6", "--detach"]);
@@ -495,20 +495,22 @@ fn an_abort_stops_the_job_and_frees_the_station_for_the_next() {
     let aborted = station.cli_ok(&["abort"]);
     assert!(aborted.contains("aborted"), "{aborted}");
     watcher.until(10, |e| matches!(e, Event::JobAborted { .. }));
-    // The daemon clears the machine after an operator's abort (no fault to remove) and takes the probe clear.
-    let mut status = station.cli_ok(&["status"]);
-    for _ in 0..100 {
-        if status.contains("machine cmm1: idle") {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-        status = station.cli_ok(&["status"]);
-    }
+    // The abort stopped the machine; it stays locked out, the probe where it stopped, until the operator clears.
+    let status = station.cli_ok(&["status"]);
     assert!(
-        status.contains("aborted") && status.contains("machine cmm1: idle"),
+        status.contains("aborted")
+            && status.contains("machine cmm1: locked out (aborted by the operator)"),
         "{status}"
     );
-    // The machine was cleared: the next job runs to its end.
+    let refused = station.cli(&["inspect", "propeller", "--serial", "SN-7"]);
+    assert!(
+        !refused.success && refused.stderr.contains("zeroset clear"),
+        "{}",
+        refused.stderr
+    );
+    let cleared = station.cli_ok(&["clear"]);
+    assert!(cleared.contains("machines clear"), "{cleared}");
+    // Cleared and clear of the part: the next job runs to its end.
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-7"]);
     let (_, report) = station.report("SN-7");
     assert_eq!(report.instances.len(), 3);

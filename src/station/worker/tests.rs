@@ -366,6 +366,7 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     let escape = EscapeModel {
         cut: Some((circle(), MARGIN_MM)),
         part: None,
+        deviation_margin_mm: MARGIN_MM,
     };
     worker
         .orders
