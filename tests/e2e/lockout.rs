@@ -142,3 +142,42 @@ fn after_a_fault_abort_moves_nothing_and_only_clear_lifts_the_lockout() {
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     station.kill_daemon();
 }
+
+#[test]
+fn an_emergency_stop_anywhere_in_a_teach_scan_is_cleared_without_a_collision_and_the_teach_finishes(
+) {
+    // The way out is planned from where the probe stopped, past the last points the machine reported, not from
+    // those points: it must never drive the ball into the blade (the simulator answers such a move with 2504).
+    let mut station = station();
+    let mut watcher = station.watch();
+    station.cli_ok(&["teach", "propeller", "--detach"]);
+    let mut stops = 0;
+    // Stops early, midway and late in different profiles' scans: on the upper surface, round the edges, below.
+    for index in [35, 170, 300] {
+        watcher.until(
+            120,
+            |e| matches!(e, Event::Point { index: i, .. } if *i == index),
+        );
+        assert_eq!(
+            station.sim.control("fault cmm1 estop"),
+            "ok fault cmm1 estop"
+        );
+        watcher.until(30, |e| matches!(e, Event::JobStopped { .. }));
+        let cleared = station.cli(&["clear"]);
+        assert!(
+            cleared.success && cleared.stdout.contains("continues"),
+            "stop {index}: {}{}",
+            cleared.stdout,
+            cleared.stderr
+        );
+        stops += 1;
+    }
+    let end = watcher.until(240, job_over);
+    assert!(matches!(end, Event::ReferenceSaved { .. }), "{end:?}");
+    let transcript = std::fs::read_to_string(station.sim.transcript("cmm1")).unwrap();
+    assert!(
+        !transcript.contains("2504"),
+        "a way out collided with the blade"
+    );
+    assert_eq!(stops, 3);
+}
