@@ -2,7 +2,9 @@
 //!
 //! - latency from a point's arrival on the line (its `received_unix_us`, stamped by the machine worker as the
 //!   point comes off the I++ client) to its deviation event at a subscriber of the control socket: p50, p99, max;
-//! - the whole inspection plan (15 profiles) on one machine and on two.
+//! - the whole inspection plan (15 profiles) on one machine and on two;
+//! - `status` answered over the control socket during a whole inspection, its set-up included, and `abort`
+//!   mid-scan: p50, p99, max of the round trip on a connection of its own, as the CLI makes it.
 //!
 //! Run: `cargo bench --bench station` (needs the release binary: cargo builds it for benches).
 
@@ -134,6 +136,28 @@ fn inspect(station: &Station, serial: &str) -> (Vec<u64>, Duration) {
     }
 }
 
+/// One request on a connection of its own; the round trip in microseconds.
+fn ask(socket: &Path, request: Request) -> u64 {
+    let started = Instant::now();
+    let mut stream = UnixStream::connect(socket).unwrap();
+    stream
+        .write_all(to_line(&RequestLine::new(request)).as_bytes())
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(&stream).read_line(&mut line).unwrap();
+    started.elapsed().as_micros() as u64
+}
+
+/// Asks `status` every 5 ms until told to stop; the round trips (us).
+fn poll_status(socket: PathBuf, stop: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Vec<u64> {
+    let mut times = Vec::new();
+    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+        times.push(ask(&socket, Request::Status));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    times
+}
+
 fn percentile(sorted: &[u64], p: f64) -> u64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
@@ -142,8 +166,37 @@ fn main() {
     // Criterion's harness flags (`--bench`) are ignored: this bench runs the station once per configuration.
     let one = start("propeller.toml");
     cli(&one.station, &["teach", "propeller"]);
+    let socket = one.root.join("zeroset.sock");
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let poller = {
+        let (socket, stop) = (socket.clone(), stop.clone());
+        std::thread::spawn(move || poll_status(socket, stop))
+    };
     let (mut latencies, one_machine) = inspect(&one, "BENCH-1");
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    let mut status = poller.join().unwrap();
+    status.sort_unstable();
+    cli(
+        &one.station,
+        &[
+            "inspect",
+            "propeller",
+            "--serial",
+            "BENCH-ABORT",
+            "--detach",
+        ],
+    );
+    std::thread::sleep(Duration::from_secs(3));
+    let abort = ask(&socket, Request::Abort);
     drop(one);
+    println!(
+        "status during an inspection (set-up included): {} asks, p50 {} us, p99 {} us, max {} us; abort mid-scan {} us",
+        status.len(),
+        percentile(&status, 0.5),
+        percentile(&status, 0.99),
+        status.last().unwrap(),
+        abort
+    );
     latencies.sort_unstable();
     println!(
         "point -> deviation event at a subscriber: {} points, p50 {} us, p99 {} us, max {} us",

@@ -8,6 +8,7 @@ mod lockout;
 mod machine_link;
 mod nut;
 mod readme;
+mod responsive;
 mod sim;
 mod station;
 mod support;
