@@ -163,3 +163,69 @@ pub fn job_motions(
         .map(|&key| scan_motion(plan, reference, key, safety))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use nalgebra::Isometry3;
+
+    use super::*;
+    use crate::config::PartConfig;
+
+    fn propeller() -> Plan {
+        let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/parts/propeller.toml");
+        Plan::new(&PartConfig::load(&file).unwrap(), Isometry3::identity())
+    }
+
+    fn safety(clearance_z_mm: f64) -> Safety {
+        Safety {
+            clearance_z_mm,
+            max_ball_radius_mm: 1.5,
+            move_margin_mm: 0.5,
+        }
+    }
+
+    #[test]
+    fn a_teach_scan_is_entered_straight_down_over_its_start_and_left_straight_up() {
+        let plan = propeller();
+        let keys = plan.teach_scans();
+        let motions = job_motions(&plan, None, &keys, &safety(150.0)).unwrap();
+        assert_eq!(motions.len(), 5);
+        let r100 = &motions[0];
+        // The part file's start point of r100, (100, 0, 23.98) with its normal up, entered 1.5 + 5 mm above it.
+        assert_eq!(r100.approach[0], Point3::new(100.0, 0.0, 150.0));
+        assert!((r100.approach[1] - Point3::new(100.0, 0.0, 30.48)).norm() < 1e-9);
+        assert!((r100.end - Point3::new(100.0, 0.0, 25.48)).norm() < 1e-9);
+        assert_eq!(r100.retract, vec![r100.approach[1], r100.approach[0]]);
+        assert!(matches!(r100.scan, Scan::InPlane(_)));
+        assert!(r100.name.contains("r100"), "{}", r100.name);
+    }
+
+    #[test]
+    fn a_clearance_height_below_the_part_is_refused_before_anything_moves() {
+        let plan = propeller();
+        let error = job_motions(&plan, None, &plan.teach_scans(), &safety(10.0)).unwrap_err();
+        let message = error.to_string();
+        assert!(
+            message.contains("clearance_z_mm") && message.contains("r100"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_path_with_a_zero_normal_is_refused_instead_of_sending_nan() {
+        let path = KnownPath {
+            surface: vec![Point3::new(100.0, 0.0, 20.0), Point3::new(100.0, 1.0, 20.0)],
+            normals: vec![Vector3::new(0.0, 0.0, 1.0), Vector3::zeros()],
+            closed: false,
+            entry: 0,
+        };
+        let plan = propeller();
+        let scan = Scan::InPlane(plan.in_plane_scan(plan.teach_scans()[0]));
+        let key = plan.teach_scans()[0];
+        let error =
+            ScanMotion::plan(key, "r100".into(), scan, path, 5.0, &safety(150.0)).unwrap_err();
+        assert!(error.to_string().contains("point 1"), "{error}");
+    }
+}
