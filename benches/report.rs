@@ -115,6 +115,7 @@ fn report() -> PartReport {
         distance: "exact".into(),
         compensation: "ball radius along the normal".into(),
         tolerance: TOLERANCE,
+        rescans: Vec::new(),
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }

@@ -164,6 +164,13 @@ pub enum Event {
         reason: String,
         next_step: String,
     },
+    /// A profile's scan came back with a hole in it (a line of points lost on the way) and is scanned again.
+    ProfileRescanned {
+        job: String,
+        machine: String,
+        scan: ScanRef,
+        reason: String,
+    },
     /// `zeroset clear` lifted the stop; the job continues.
     JobResumed { job: String },
     /// A teach saved its reference model.

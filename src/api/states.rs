@@ -47,6 +47,9 @@ pub enum FaultKind {
     Refused,
     /// The job's analysis or recording stopped under the scan.
     Station,
+    /// The scan ended well but has a hole (a line of points lost on the way): not a fault of the machine, which
+    /// stays ready; the profile is scanned again.
+    Gap,
 }
 
 /// Where a job is.
@@ -130,6 +133,7 @@ impl fmt::Display for FaultKind {
             Self::Aborted => f.write_str("aborted by the operator"),
             Self::Refused => f.write_str("the station refused to move"),
             Self::Station => f.write_str("station fault"),
+            Self::Gap => f.write_str("a gap in the scan"),
         }
     }
 }

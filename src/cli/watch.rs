@@ -116,6 +116,15 @@ impl Watch {
                 reason, next_step, ..
             } => self.line(format!("STOPPED: {reason}\n  next: {next_step}")),
             Event::JobResumed { job } => self.line(format!("job {job} resumed")),
+            Event::ProfileRescanned {
+                machine,
+                scan,
+                reason,
+                ..
+            } => self.line(format!(
+                "{} {} on {machine} scanned again: {reason}",
+                scan.instance, scan.profile
+            )),
             Event::ReferenceSaved { path, profiles, .. } => {
                 self.finish_bars();
                 self.line(format!("reference saved: {}", path.display()));
@@ -231,6 +240,7 @@ fn event_job(event: &Event) -> Option<&str> {
         Event::ScanStarted { job, .. }
         | Event::Point { job, .. }
         | Event::ProfileDone { job, .. }
+        | Event::ProfileRescanned { job, .. }
         | Event::JobStopped { job, .. }
         | Event::JobResumed { job }
         | Event::ReferenceSaved { job, .. }

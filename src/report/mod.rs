@@ -53,6 +53,20 @@ pub struct PartReport {
     pub instances: Vec<InstanceReport>,
     /// Pass iff every instance passes.
     pub verdict: Verdict,
+    /// Profiles scanned again because a scan came back with a hole in it (absent from older reports).
+    #[serde(default)]
+    pub rescans: Vec<Rescan>,
+}
+
+/// A profile scanned again, and why.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct Rescan {
+    pub instance: String,
+    pub profile: String,
+    /// What was wrong with the first scan: where its gap was and how long, mm.
+    pub reason: String,
+    /// RFC 3339.
+    pub at: String,
 }
 
 /// A machine that scanned some of the part's profiles.

@@ -98,6 +98,7 @@ pub(super) fn sample_report() -> PartReport {
         distance: "exact orthogonal distance to each profile's 2-D IP".to_string(),
         compensation: "ball radius along the reported normal".to_string(),
         tolerance: TOLERANCE,
+        rescans: Vec::new(),
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }

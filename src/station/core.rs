@@ -369,6 +369,11 @@ impl Core {
     }
 
     fn scan_ended(&mut self, machine: &str, key: ProfileKey, result: ScanResult) {
+        if let Err(error) = &result {
+            if error.kind == FaultKind::Gap {
+                return self.gap(machine, key, error);
+            }
+        }
         let aborting = self
             .job
             .as_ref()
@@ -420,6 +425,72 @@ impl Core {
             }
         }
         self.abort_done_if_stopped();
+    }
+
+    /// A scan that ended well with a hole in it: the machine is ready; the profile is scanned again once, and a
+    /// second hole stops the job.
+    fn gap(&mut self, machine: &str, key: ProfileKey, error: &WorkerError) {
+        if let Some(slot) = self.slot(machine) {
+            slot.state = MachineState::Idle;
+        }
+        let Some(job) = self.job.as_mut() else {
+            return;
+        };
+        let scan = scan_ref(&job.plan, key);
+        if !job.stored.contains(&key) && !job.remaining.contains(&key) {
+            job.remaining.insert(0, key);
+        }
+        let first = job.rescanned.insert(key);
+        job.record.rescans.push(crate::report::Rescan {
+            instance: scan.instance.clone(),
+            profile: scan.profile.clone(),
+            reason: error.message.clone(),
+            at: super::clock::now_rfc3339(),
+        });
+        let (dir, record) = (job.dir.clone(), job.record.clone());
+        let id = job.info.id.clone();
+        if first && job.phase == JobPhase::Running {
+            tracing::warn!(job = %id, machine, scan = %job.plan.describe(key), error = %error.message, "scanning again");
+            self.emit(Effect::SaveRecord { dir, record });
+            self.publish(Event::ProfileRescanned {
+                job: id,
+                machine: machine.to_string(),
+                scan,
+                reason: error.message.clone(),
+            });
+            return;
+        }
+        let running = job.phase == JobPhase::Running;
+        self.emit(Effect::SaveRecord { dir, record });
+        if !running {
+            return self.abort_done_if_stopped();
+        }
+        let Some(job) = self.job.as_mut() else {
+            return;
+        };
+        let next_step = "check the line to the machine (cable, controller), then run `zeroset clear`: the profile \
+                         is scanned again"
+            .to_string();
+        let reason = format!(
+            "{} of part {} has a hole again after a rescan: {}",
+            job.plan.describe(key),
+            job.info.part,
+            error.message
+        );
+        tracing::error!(job = %id, machine, %reason, "job stopped");
+        job.phase = JobPhase::Stopped {
+            machine: Some(machine.to_string()),
+            scan: Some(scan.clone()),
+            reason: reason.clone(),
+            next_step: next_step.clone(),
+        };
+        self.publish(Event::JobStopped {
+            job: id,
+            machine: Some(machine.to_string()),
+            scan: Some(scan),
+            reason,
+            next_step,
+        });
     }
 
     fn stored(&mut self, job_id: &str, key: ProfileKey, result: Result<(), String>) {

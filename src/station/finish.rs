@@ -267,6 +267,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         tolerance: inputs.tolerance,
         instances,
         verdict: verdict.clone(),
+        rescans: inputs.record.rescans.clone(),
     };
     let folder = inputs
         .reports

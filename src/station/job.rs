@@ -39,6 +39,8 @@ pub struct Job {
     pub cut_paths: Vec<(String, KnownPath, f64)>,
     pub remaining: Vec<ProfileKey>,
     pub stored: BTreeSet<ProfileKey>,
+    /// Profiles already scanned again for a hole in their scan: a second hole stops the job.
+    pub rescanned: BTreeSet<ProfileKey>,
     pub total: usize,
     pub phase: JobPhase,
 }
@@ -194,6 +196,7 @@ impl Job {
             started,
             state: JobState::Open,
             report: None,
+            rescans: Vec::new(),
         };
         let dir = JobDir::create(&config.folders.data, &record)
             .map_err(|e| JobError(format!("cannot start the job: {e}")))?;
@@ -289,6 +292,7 @@ impl Job {
             cut_paths: Vec::new(),
             remaining,
             stored,
+            rescanned: BTreeSet::new(),
             total: keys.len(),
             phase: JobPhase::Running,
         }

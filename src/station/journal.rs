@@ -31,6 +31,9 @@ pub struct JobRecord {
     pub state: JobState,
     /// The folder of the inspection's report, once written.
     pub report: Option<PathBuf>,
+    /// Profiles scanned again because their scan had a hole (absent from older records).
+    #[serde(default)]
+    pub rescans: Vec<crate::report::Rescan>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -290,6 +293,7 @@ mod tests {
             started: "2026-11-23T10:00:00Z".into(),
             state: JobState::Open,
             report: None,
+            rescans: Vec::new(),
         }
     }
 

@@ -11,6 +11,7 @@ mod core;
 mod daemon;
 mod escape;
 mod finish;
+mod gaps;
 mod job;
 mod journal;
 mod motion;

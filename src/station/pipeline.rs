@@ -304,6 +304,7 @@ mod tests {
             started: "2026-11-23T10:00:00Z".into(),
             state: JobState::Open,
             report: None,
+            rescans: Vec::new(),
         };
         let dir = JobDir::create(data.path(), &record).unwrap();
         let (events, mut watch) = broadcast::channel(4 * QUEUE_POINTS);

@@ -17,6 +17,7 @@ use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
 
 use super::escape::{plan_escape, EscapeModel, KnownPath};
+use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
 use super::pipeline::PipelineMsg;
 use super::DaemonMsg;
@@ -230,6 +231,10 @@ impl Worker {
     /// aborted", and the operator needs to read why, and the daemon to know it was an emergency stop); a lost
     /// link is forgotten, so that the next order opens it again. Every failed order passes here.
     fn failed(&mut self, error: WorkerError) -> WorkerError {
+        if error.kind == FaultKind::Gap {
+            // The machine did all it was asked: nothing to set up again.
+            return error;
+        }
         let alarms = self.alarms();
         if error.kind == FaultKind::Transport {
             *self.link.lock().expect("not poisoned") = None;
@@ -444,15 +449,31 @@ impl Worker {
             Ok(stream) => self.stream(stream, &motion, &pipeline, radius).await,
             Err(error) => Err(error.into()),
         };
-        let end = match &streamed {
-            Ok(()) => PipelineMsg::End { key: motion.key },
-            Err(_) => PipelineMsg::Cut { key: motion.key },
+        // A scan that ended well may still have lost a line of points on the way: then it is kept as a cut scan,
+        // not counted, and scanned again.
+        let gap = streamed
+            .as_ref()
+            .ok()
+            .and_then(|centres| find_gap(&motion, centres));
+        let end = match (&streamed, &gap) {
+            (Ok(_), None) => PipelineMsg::End { key: motion.key },
+            _ => PipelineMsg::Cut { key: motion.key },
         };
         if pipeline.send(end).await.is_err() {
             return Err(self.pipeline_gone());
         }
         streamed?;
-        self.retract(&client, &motion).await
+        self.retract(&client, &motion).await?;
+        match gap {
+            None => Ok(()),
+            Some(gap) => Err(WorkerError {
+                kind: FaultKind::Gap,
+                message: format!(
+                    "machine {}: the scan of {} is not whole: {gap}",
+                    self.name, motion.name
+                ),
+            }),
+        }
     }
 
     /// The planned lift-off and way out, sent only if the scan ended where the plan has it end.
@@ -483,15 +504,16 @@ impl Worker {
     }
 
     /// Forwards the scan's points to the pipeline as they arrive, extending the known path with them when the
-    /// profile's shape was unknown.
+    /// profile's shape was unknown. Returns the ball centres, for the check that the scan is whole.
     async fn stream(
         &mut self,
         mut stream: ScanStream,
         motion: &ScanMotion,
         pipeline: &mpsc::Sender<PipelineMsg>,
         radius: f64,
-    ) -> ScanResult {
+    ) -> Result<Vec<Point3<f64>>, WorkerError> {
         let teaching = matches!(motion.scan, Scan::InPlane(_));
+        let mut centres = Vec::new();
         while let Some(item) = stream.next().await {
             let received_us = super::clock::unix_us();
             let point = item?;
@@ -509,6 +531,7 @@ impl Worker {
                     }
                 }
             }
+            centres.push(Point3::from(raw.centre));
             let message = PipelineMsg::Point {
                 key: motion.key,
                 raw,
@@ -523,7 +546,7 @@ impl Worker {
                 path.closed = true;
             }
         }
-        Ok(())
+        Ok(centres)
     }
 
     fn pipeline_gone(&self) -> WorkerError {

@@ -60,7 +60,7 @@ fn stopped_at(entries: &[(f64, char, String)], from: f64) -> f64 {
 }
 
 /// A station whose client gives up on a silent line after 3 s (the default waits minutes for homing).
-fn station() -> Station {
+pub fn station() -> Station {
     Station::start_edited("propeller.toml", "station.toml", |table| {
         let machines = table["machines"].as_array_mut().unwrap();
         for machine in machines {

@@ -5,6 +5,7 @@ mod daemon;
 mod errors;
 mod fit_and_deviate;
 mod lockout;
+mod lost_points;
 mod machine_link;
 mod nut;
 mod readme;

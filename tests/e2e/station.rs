@@ -144,7 +144,7 @@ fn teach(station: &Station) {
 }
 
 /// Points per profile of an inspection report.
-fn point_counts(report: &PartReport) -> BTreeMap<(String, String), usize> {
+pub fn point_counts(report: &PartReport) -> BTreeMap<(String, String), usize> {
     report
         .instances
         .iter()
@@ -157,7 +157,7 @@ fn point_counts(report: &PartReport) -> BTreeMap<(String, String), usize> {
 }
 
 /// No point of a profile appears twice (a resumed scan appended to a cut one would repeat the start).
-fn assert_no_repeated_points(report: &PartReport) {
+pub fn assert_no_repeated_points(report: &PartReport) {
     for instance in &report.instances {
         for profile in &instance.profiles {
             for (i, a) in profile.points.iter().enumerate() {

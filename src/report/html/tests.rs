@@ -128,6 +128,7 @@ fn propeller(instances: Vec<InstanceReport>) -> PartReport {
         distance: "exact orthogonal distance".to_string(),
         compensation: "ball radius along the normal".to_string(),
         tolerance: TOLERANCE,
+        rescans: Vec::new(),
         verdict: if failing == 0 {
             Verdict::Pass
         } else {

@@ -142,6 +142,7 @@ fn two_blade_report() -> PartReport {
         distance: "exact orthogonal distance to each profile's 2-D IP".to_string(),
         compensation: "ball radius along the reported normal".to_string(),
         tolerance: TOLERANCE,
+        rescans: Vec::new(),
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }

@@ -462,3 +462,42 @@ fn a_failed_clear_keeps_the_machine_locked_out_and_says_why() {
     assert_eq!(fault.kind, FaultKind::Refused);
     assert!(matches!(bench.phase(), JobPhase::Stopped { .. }));
 }
+
+#[test]
+fn a_scan_with_a_hole_is_scanned_again_once_and_a_second_hole_stops_the_job() {
+    let mut bench = Bench::new();
+    let key = scanned(&bench.start_teach()).unwrap();
+    let gap = || {
+        WorkerError {
+        kind: FaultKind::Gap,
+        message: "machine cmm1: the scan of instance A, profile r100 is not whole: a gap of 10.0 mm after point 40"
+            .into(),
+    }
+    };
+    let effects = bench.scan_ended(key, Err(gap()));
+    assert!(published(
+        &effects,
+        |e| matches!(e, Event::ProfileRescanned { reason, .. } if reason.contains("10.0 mm"))
+    ));
+    assert_eq!(
+        scanned(&effects),
+        Some(key),
+        "the same profile, again, at once"
+    );
+    assert!(effects
+        .iter()
+        .any(|e| matches!(e, Effect::SaveRecord { record, .. } if record.rescans.len() == 1)));
+    assert_eq!(bench.phase(), JobPhase::Running);
+    let effects = bench.scan_ended(key, Err(gap()));
+    assert!(!touches_a_machine(&effects));
+    assert!(published(
+        &effects,
+        |e| matches!(e, Event::JobStopped { reason, .. } if reason.contains("again after a rescan"))
+    ));
+    assert_eq!(
+        bench.machine(),
+        MachineState::Idle,
+        "a hole is no fault of the machine"
+    );
+    assert_eq!(bench.core.job().unwrap().record.rescans.len(), 2);
+}

@@ -1,0 +1,170 @@
+//! Whether a scan that ended well is whole: a line of points lost on the way (the machine's data lines carry
+//! several points each) leaves a hole the machine never reports. A scan along a nominal curve is followed along
+//! that curve: each ball centre is placed at its arc length on the nominal path, and a step along it longer than
+//! the scan's spacing allows, or a start or an end short of the curve's, is a gap. A teach scan has no nominal:
+//! its ball centres must lie no further apart than its step allows, and close where they began.
+
+use std::fmt;
+
+use nalgebra::Point3;
+
+use super::motion::{Scan, ScanMotion};
+
+/// A step is a gap when it is longer than this many times the median of the steps before it...
+const LOCAL_FACTOR: f64 = 3.0;
+/// ...and longer than this many times the largest spacing of the nominal points (a curve scan) or the step
+/// (a teach scan): a machine reports at least one point per nominal, and a teach scan one per step.
+const SPACING_FACTOR: f64 = 1.5;
+/// How many steps the local median looks back over.
+const WINDOW: usize = 10;
+/// How far ahead along the nominal path the next point is looked for, in nominal spacings: far enough for any
+/// hole, near enough that the two faces of a thin edge are not confused.
+const LOOK_AHEAD: f64 = 40.0;
+
+/// A hole in a scan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gap {
+    /// The last point before the hole (`None`: the hole is at the scan's start).
+    pub after: Option<usize>,
+    /// Where the hole begins (a ball centre, machine coordinates, mm).
+    pub at: Point3<f64>,
+    /// How long the hole is along the scan, mm.
+    pub length_mm: f64,
+}
+
+impl fmt::Display for Gap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let after = match self.after {
+            Some(i) => format!("after point {i}"),
+            None => "at its start".to_string(),
+        };
+        write!(
+            f,
+            "a gap of {:.1} mm {after}, at ({:.3}, {:.3}, {:.3}) mm",
+            self.length_mm, self.at.x, self.at.y, self.at.z
+        )
+    }
+}
+
+/// The first hole in the ball centres of a scan of `motion` that ended well, if any.
+pub fn find_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
+    match &motion.scan {
+        Scan::Curve(_) => curve_gap(motion, centres),
+        Scan::InPlane(scan) => teach_gap(motion, centres, scan.step, scan.stop_diameter),
+    }
+}
+
+/// The first step longer than its allowance: `SPACING_FACTOR * spacing`, and `LOCAL_FACTOR` times the local
+/// median step.
+fn first_long_step(positions: &[f64], spacing: f64) -> Option<(usize, f64)> {
+    let steps: Vec<f64> = positions.windows(2).map(|w| w[1] - w[0]).collect();
+    (0..steps.len()).find_map(|i| {
+        let mut before: Vec<f64> = steps[i.saturating_sub(WINDOW)..i].to_vec();
+        before.sort_by(f64::total_cmp);
+        let median = before.get(before.len() / 2).copied().unwrap_or(0.0);
+        let allowed = (SPACING_FACTOR * spacing).max(LOCAL_FACTOR * median);
+        (steps[i] > allowed).then_some((i, steps[i]))
+    })
+}
+
+fn curve_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
+    let path = &motion.path;
+    let n = path.surface.len();
+    let segments = if path.closed { n } else { n - 1 };
+    let length = |i: usize| (path.surface[(i + 1) % n] - path.surface[i]).norm();
+    let mut start_of = Vec::with_capacity(segments + 1);
+    let mut total = 0.0;
+    for i in 0..segments {
+        start_of.push(total);
+        total += length(i);
+    }
+    let spacing = (0..segments).map(length).fold(0.0, f64::max);
+    let entry = start_of.get(path.entry).copied().unwrap_or(0.0);
+    // Arc lengths from the entry, in the direction of travel, each looked for ahead of the last.
+    let mut positions = Vec::with_capacity(centres.len());
+    let mut last = 0.0;
+    for centre in centres {
+        let mut best = (f64::INFINITY, last);
+        for (i, &from) in start_of.iter().enumerate() {
+            let (a, b) = (path.surface[i], path.surface[(i + 1) % n]);
+            let ab = b - a;
+            let t = ((centre - a).dot(&ab) / ab.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+            let distance = (centre - (a + ab * t)).norm();
+            let mut along = from + t * ab.norm() - entry;
+            if path.closed && along < 0.0 {
+                along += total;
+            }
+            let ahead = along - last;
+            if (-spacing..=LOOK_AHEAD * spacing).contains(&ahead) && distance < best.0 {
+                best = (distance, along);
+            }
+        }
+        last = best.1.max(last);
+        positions.push(last);
+    }
+    let Some(&first) = positions.first() else {
+        return Some(Gap {
+            after: None,
+            at: motion.end,
+            length_mm: total,
+        });
+    };
+    let allowed = SPACING_FACTOR * spacing;
+    if first > allowed {
+        return Some(Gap {
+            after: None,
+            at: path.surface[path.entry],
+            length_mm: first,
+        });
+    }
+    if let Some((i, step)) = first_long_step(&positions, spacing) {
+        return Some(Gap {
+            after: Some(i),
+            at: centres[i],
+            length_mm: step,
+        });
+    }
+    let end = if path.closed { total } else { total - entry };
+    let short = end - positions[positions.len() - 1];
+    (short > allowed).then(|| Gap {
+        after: Some(centres.len() - 1),
+        at: centres[centres.len() - 1],
+        length_mm: short,
+    })
+}
+
+fn teach_gap(
+    motion: &ScanMotion,
+    centres: &[Point3<f64>],
+    step: f64,
+    stop_diameter: f64,
+) -> Option<Gap> {
+    let (Some(first), Some(last)) = (centres.first(), centres.last()) else {
+        return Some(Gap {
+            after: None,
+            at: motion.end,
+            length_mm: 0.0,
+        });
+    };
+    let mut travelled = vec![0.0];
+    for pair in centres.windows(2) {
+        travelled.push(travelled[travelled.len() - 1] + (pair[1] - pair[0]).norm());
+    }
+    if let Some((i, length)) = first_long_step(&travelled, step) {
+        return Some(Gap {
+            after: Some(i),
+            at: centres[i],
+            length_mm: length,
+        });
+    }
+    // The scan closes in the stop sphere round its start.
+    let short = (last - first).norm();
+    (short > SPACING_FACTOR * step + stop_diameter).then(|| Gap {
+        after: Some(centres.len() - 1),
+        at: *last,
+        length_mm: short,
+    })
+}
+
+#[cfg(test)]
+mod tests;

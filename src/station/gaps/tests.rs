@@ -1,0 +1,155 @@
+//! Gaps found where lines of points were lost, and none in whole scans: round a circle, along a NACA 4412 with
+//! its sharp trailing edge (the real blade 0.4 mm off the nominal, as blade B), and in a teach scan.
+
+use nalgebra::{Point3, Vector3};
+use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Xyz};
+use zeroset_sim::naca::Naca4;
+
+use super::*;
+use crate::config::Safety;
+use crate::plan::ProfileKey;
+use crate::station::escape::KnownPath;
+
+fn safety() -> Safety {
+    Safety {
+        clearance_z_mm: 150.0,
+        max_ball_radius_mm: 1.5,
+        move_margin_mm: 0.5,
+    }
+}
+
+const KEY: ProfileKey = ProfileKey {
+    instance: 1,
+    profile: 0,
+};
+
+fn curve_motion(path: KnownPath) -> ScanMotion {
+    let scan = Scan::Curve(CurveScan {
+        closed: true,
+        nominals: Vec::new(),
+        max_deviation: 3.0,
+        min_radius: 1.0,
+        density: Density::AtNominals,
+    });
+    ScanMotion::plan(KEY, "B r300".into(), scan, path, 5.0, &safety()).unwrap()
+}
+
+/// A NACA 4412 of 100 mm chord in the plane x = 300, entered at the top of its upper surface; `count` nominals.
+fn naca_path(count: usize) -> KnownPath {
+    let naca = Naca4::from_digits("4412", 100.0, true).unwrap();
+    let points: Vec<Point3<f64>> = naca
+        .points(count)
+        .into_iter()
+        .map(|[x, z]| Point3::new(300.0, x - 50.0, z))
+        .collect();
+    let n = points.len();
+    let normals: Vec<Vector3<f64>> = (0..n)
+        .map(|i| {
+            let d = points[(i + 1) % n] - points[(i + n - 1) % n];
+            Vector3::new(0.0, d.z, -d.y).normalize()
+        })
+        .collect();
+    let top = (0..n / 2)
+        .max_by(|&a, &b| points[a].z.total_cmp(&points[b].z))
+        .unwrap();
+    // Entered at the top: the path starts there, as the station's curve scans do.
+    let order: Vec<usize> = (0..n).map(|k| (top + k) % n).collect();
+    KnownPath {
+        surface: order.iter().map(|&i| points[i]).collect(),
+        normals: order.iter().map(|&i| normals[i]).collect(),
+        closed: true,
+        entry: 0,
+    }
+}
+
+/// Ball centres of a whole closed scan over `path`: the ball (1 mm) on a surface `offset` mm off the nominal,
+/// `per` points per nominal spacing.
+fn centres(path: &KnownPath, offset: f64, per: usize) -> Vec<Point3<f64>> {
+    let n = path.surface.len();
+    (0..n)
+        .flat_map(|i| {
+            let j = (i + 1) % n;
+            (0..per).map(move |k| (i, j, k as f64 / per as f64))
+        })
+        .map(|(i, j, t)| {
+            let p = path.surface[i] + (path.surface[j] - path.surface[i]) * t;
+            let normal = (path.normals[i] * (1.0 - t) + path.normals[j] * t).normalize();
+            p + normal * (1.0 + offset)
+        })
+        .collect()
+}
+
+#[test]
+fn a_whole_scan_has_no_gap_even_round_a_sharp_edge_and_off_the_nominal() {
+    for (count, per, offset) in [(120, 1, 0.0), (200, 2, 0.4), (200, 3, -0.4), (400, 1, 1.0)] {
+        let path = naca_path(count);
+        let motion = curve_motion(path.clone());
+        let scan = centres(&path, offset, per);
+        assert_eq!(
+            find_gap(&motion, &scan),
+            None,
+            "{count} nominals, {per} per spacing"
+        );
+    }
+}
+
+#[test]
+fn a_lost_line_of_points_is_a_gap_wherever_it_was_lost() {
+    let path = naca_path(200);
+    let motion = curve_motion(path.clone());
+    let whole = centres(&path, 0.4, 2);
+    for lost_from in [0, 37, 150, 199, 330, whole.len() - 10] {
+        let mut scan = whole.clone();
+        scan.drain(lost_from..lost_from + 10);
+        let gap =
+            find_gap(&motion, &scan).unwrap_or_else(|| panic!("10 points lost at {lost_from}"));
+        assert!(gap.length_mm > 3.0, "{gap}");
+        match lost_from {
+            0 => assert_eq!(gap.after, None),
+            _ => assert_eq!(gap.after, Some(lost_from - 1), "{gap}"),
+        }
+    }
+    // Nothing at all is a gap too.
+    assert!(find_gap(&motion, &[]).is_some());
+}
+
+fn teach_motion() -> ScanMotion {
+    let start = Point3::new(100.0, 0.0, 20.0);
+    let path = KnownPath {
+        surface: vec![start],
+        normals: vec![Vector3::new(0.0, 0.0, 1.0)],
+        closed: false,
+        entry: 0,
+    };
+    let xyz = |x, y, z| Xyz::new(x, y, z);
+    let scan = Scan::InPlane(InPlaneScan {
+        start: xyz(100.0, 0.0, 20.0),
+        start_normal: xyz(0.0, 0.0, 1.0),
+        plane_normal: xyz(1.0, 0.0, 0.0),
+        direction: xyz(100.0, 1.0, 20.0),
+        step: 1.0,
+        end: xyz(100.0, 0.0, 20.0),
+        stop_diameter: 3.0,
+        passes: 1,
+        end_normal: xyz(0.0, 0.0, 1.0),
+    });
+    ScanMotion::plan(KEY, "A r100".into(), scan, path, 5.0, &safety()).unwrap()
+}
+
+#[test]
+fn a_teach_scan_is_whole_when_its_steps_are_and_it_closes() {
+    // Round a circle of 20 mm (ball centres on 21 mm) at 1 mm steps, ending inside the stop sphere.
+    let centre = |k: usize| {
+        let t = std::f64::consts::FRAC_PI_2 + k as f64 / 21.0;
+        Point3::new(100.0, 21.0 * t.cos(), 21.0 * t.sin())
+    };
+    let turn = (std::f64::consts::TAU * 21.0).floor() as usize;
+    let whole: Vec<Point3<f64>> = (0..turn).map(centre).collect();
+    let motion = teach_motion();
+    assert_eq!(find_gap(&motion, &whole), None);
+    let mut holed = whole.clone();
+    holed.drain(60..70);
+    assert_eq!(find_gap(&motion, &holed).unwrap().after, Some(59));
+    let cut = &whole[..turn - 10];
+    assert_eq!(find_gap(&motion, cut).unwrap().after, Some(turn - 11));
+}
