@@ -499,7 +499,10 @@ impl Core {
         };
         let error = match result {
             Ok(()) => {
+                // The scan may have been put back for scanning when its machine failed after the last point
+                // (the way out collided): its points are on disk, so it is done and never scanned again.
                 job.stored.insert(key);
+                job.remaining.retain(|k| *k != key);
                 return;
             }
             Err(error) => error,

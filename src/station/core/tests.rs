@@ -501,3 +501,31 @@ fn a_scan_with_a_hole_is_scanned_again_once_and_a_second_hole_stops_the_job() {
     );
     assert_eq!(bench.core.job().unwrap().record.rescans.len(), 2);
 }
+
+#[test]
+fn a_profile_stored_after_its_machine_failed_on_the_way_out_is_not_scanned_again() {
+    let mut bench = Bench::new();
+    let key = scanned(&bench.start_teach()).unwrap();
+    let job_id = bench.core.job().unwrap().info.id.clone();
+    // The scan's points all came; the lift-off collided; the recorder stores the scan after the failure.
+    let collision = WorkerError {
+        kind: FaultKind::Device {
+            severity: 3,
+            code: 2504,
+        },
+        message: "machine cmm1: GoTo: collision".into(),
+    };
+    bench.scan_ended(key, Err(collision));
+    bench.core.handle(Input::Stored {
+        job: job_id,
+        key,
+        result: Ok(()),
+    });
+    bench.request(Request::Clear);
+    let effects = bench.core.handle(Input::Cleared {
+        machine: MACHINE.into(),
+        result: Ok(()),
+    });
+    let next = scanned(&effects).expect("the job continues");
+    assert_ne!(next, key, "the stored profile is not scanned again");
+}
