@@ -97,23 +97,91 @@ impl JobDir {
         write_atomically(&self.root.join("job.json"), &json)
     }
 
-    /// The profiles whose scans are complete on disk.
+    /// The profiles whose scans are complete on disk: each scan file as its check (`*.check.json`, written
+    /// after the scan file was read back) recorded it, byte for byte, and whole. A scan file that fails this (cut
+    /// short, changed, its check missing) is set aside, kept, and its profile counts as not done.
     pub fn completed(&self) -> io::Result<Vec<String>> {
         let mut names = Vec::new();
         for entry in fs::read_dir(self.root.join("scans"))? {
             let name = entry?.file_name().to_string_lossy().into_owned();
-            if let Some(stem) = name.strip_suffix(".json") {
-                names.push(stem.to_string());
+            let Some(stem) = name.strip_suffix(".json") else {
+                continue;
+            };
+            if stem.ends_with(".check") {
+                continue;
+            }
+            match self.verify(stem) {
+                Ok(()) => names.push(stem.to_string()),
+                Err(problem) => {
+                    tracing::error!(scan = stem, %problem, "a scan file on disk is not whole; its profile is scanned again");
+                    self.set_aside(stem, "bad")?;
+                }
             }
         }
         names.sort();
         Ok(names)
     }
 
-    /// Writes a complete scan (atomically), then removes its partial file: from here on it counts as done.
+    /// Whether the scan file `stem` is the one its check recorded, and reads back whole.
+    fn verify(&self, stem: &str) -> Result<(), String> {
+        let scans = self.root.join("scans");
+        let bytes = fs::read(scans.join(format!("{stem}.json"))).map_err(|e| e.to_string())?;
+        let check: ScanCheck = read_json(&scans.join(format!("{stem}.check.json")))
+            .map_err(|e| format!("its check: {e}"))?;
+        let found = ScanCheck::of(&bytes, check.points);
+        if found != check {
+            return Err(format!(
+                "{} bytes with checksum {:08x}, its check recorded {} bytes with checksum {:08x}",
+                found.bytes, found.crc32, check.bytes, check.crc32
+            ));
+        }
+        let file: ScanFile = serde_json::from_slice(&bytes).map_err(|e| e.to_string())?;
+        if file.points.len() != check.points {
+            return Err(format!(
+                "{} points, its check recorded {}",
+                file.points.len(),
+                check.points
+            ));
+        }
+        Ok(())
+    }
+
+    /// Renames a scan file and its check out of the way (kept: nothing measured is deleted).
+    fn set_aside(&self, stem: &str, why: &str) -> io::Result<()> {
+        let scans = self.root.join("scans");
+        let stamp = crate::station::clock::unix_ms();
+        for suffix in ["json", "check.json"] {
+            let path = scans.join(format!("{stem}.{suffix}"));
+            if path.exists() {
+                fs::rename(
+                    &path,
+                    scans.join(format!("{stem}.{why}-{stamp}.{suffix}.kept")),
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes a complete scan (atomically), reads it back, writes its check, then removes its partial file: from
+    /// here on it counts as done.
     pub fn write_scan(&self, scan: &ScanRef, file: &ScanFile) -> io::Result<()> {
         let json = serde_json::to_vec(file).expect("a scan serialises");
-        write_atomically(&self.scan_path(scan), &json)?;
+        let path = self.scan_path(scan);
+        write_atomically(&path, &json)?;
+        let back = fs::read(&path)?;
+        let check = ScanCheck::of(&json, file.points.len());
+        if ScanCheck::of(&back, file.points.len()) != check {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{} does not read back as written", path.display()),
+            ));
+        }
+        let stem = file_stem(scan);
+        let check_path = self.root.join("scans").join(format!("{stem}.check.json"));
+        write_atomically(
+            &check_path,
+            &serde_json::to_vec(&check).expect("a check serialises"),
+        )?;
         match fs::remove_file(self.partial_path(scan)) {
             Err(e) if e.kind() != io::ErrorKind::NotFound => Err(e),
             _ => Ok(()),
@@ -239,6 +307,24 @@ impl PartialScan {
     }
 }
 
+/// What a complete scan file was when written: its length, its CRC-32 and its point count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+struct ScanCheck {
+    points: usize,
+    bytes: usize,
+    crc32: u32,
+}
+
+impl ScanCheck {
+    fn of(bytes: &[u8], points: usize) -> ScanCheck {
+        ScanCheck {
+            points,
+            bytes: bytes.len(),
+            crc32: crc32fast::hash(bytes),
+        }
+    }
+}
+
 /// The file name of a profile's scan: instance and profile names joined.
 pub fn file_stem(scan: &ScanRef) -> String {
     format!("{}-{}", scan.instance, scan.profile)
@@ -359,6 +445,53 @@ mod tests {
         assert_eq!(dir.completed().unwrap(), vec!["B-r300".to_string()]);
         assert!(dir.read_partial(&scan).unwrap().is_none());
         assert_eq!(dir.read_scan(&scan).unwrap(), file);
+    }
+
+    #[test]
+    fn a_scan_file_cut_short_changed_or_without_its_check_is_not_done_and_is_kept_aside() {
+        let data = tempfile::tempdir().unwrap();
+        let dir = JobDir::create(data.path(), &record()).unwrap();
+        let scans = dir.path().join("scans");
+        let file = ScanFile {
+            header: header(),
+            finished: "t2".into(),
+            points: (0..50).map(|i| point(i as f64)).collect(),
+        };
+        for (instance, spoil) in [("A", 0), ("B", 1), ("C", 2), ("D", 3)] {
+            let scan = scan_ref(instance, "r100");
+            dir.write_scan(&scan, &file).unwrap();
+            let path = scans.join(format!("{instance}-r100.json"));
+            let bytes = fs::read(&path).unwrap();
+            match spoil {
+                // Cut short, as a full disk or a crash of the file system leaves it.
+                1 => fs::write(&path, &bytes[..bytes.len() / 2]).unwrap(),
+                // One digit changed: the same length, another checksum.
+                2 => {
+                    let text = String::from_utf8(bytes).unwrap().replacen("17", "18", 1);
+                    fs::write(&path, text).unwrap();
+                }
+                3 => fs::remove_file(scans.join(format!("{instance}-r100.check.json"))).unwrap(),
+                _ => {}
+            }
+        }
+        assert_eq!(dir.completed().unwrap(), vec!["A-r100".to_string()]);
+        // The bad ones are kept beside, and are not read as scans again.
+        let kept = fs::read_dir(&scans)
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .contains(".bad-")
+            })
+            .count();
+        assert_eq!(
+            kept,
+            3 + 2,
+            "three scan files and the two checks that remained"
+        );
+        assert_eq!(dir.completed().unwrap(), vec!["A-r100".to_string()]);
     }
 
     #[test]
