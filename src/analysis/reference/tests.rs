@@ -216,3 +216,18 @@ fn teaching_refuses_what_cannot_make_a_reference() {
         TeachError::BadSpacing { .. }
     ));
 }
+
+/// The part files' bound on the degree is one the teach can do: above it the fit panicked.
+#[test]
+fn the_highest_degree_a_part_file_may_give_teaches() {
+    let settings = ReferenceSettings::ImplicitPolynomial {
+        degree: crate::config::part::MAX_REFERENCE_DEGREE,
+        method: FitMethod::Orthogonal,
+        nominal_spacing_mm: 5.0,
+    };
+    let reference = teach("ellipse-blade", &masters(), &settings).expect("degree 14 teaches");
+    let ReferenceModel::Stack { profiles } = &reference.model.model else {
+        panic!("not a stack");
+    };
+    assert!(profiles.iter().all(|p| p.fitted.ip.poly.degree() == 14));
+}
