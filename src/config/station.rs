@@ -29,6 +29,10 @@ pub struct StationConfig {
     /// offset is one change here rather than in every part file.
     #[serde(default)]
     pub part_to_machine: Pose,
+    /// The file this was read from, for checks made later to name (a part's clearance: see
+    /// [`crate::plan::check_clearance`]); empty when not loaded from a file.
+    #[serde(skip)]
+    pub file: PathBuf,
 }
 
 /// One CMM and the line it is reached on.
@@ -70,7 +74,8 @@ pub(crate) const MAX_TIMEOUT_S: f64 = 3600.0;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Safety {
-    /// The height (part frame, z) of free travel between profiles.
+    /// The height of free travel between profiles: machine z, which is the part frame's z when part_to_machine
+    /// neither raises nor tilts the part. It must clear the part ([`crate::plan::check_clearance`]).
     pub clearance_z_mm: f64,
     /// A tool whose ball is bigger than this is refused.
     pub max_ball_radius_mm: f64,
@@ -131,6 +136,7 @@ impl StationConfig {
             path: path.to_owned(),
             problem,
         })?;
+        config.file = path.to_owned();
         let folder = folder_of(path)?;
         for relative in [
             &mut config.folders.data,
@@ -426,6 +432,7 @@ mod tests {
             std::time::Duration::from_secs_f64(config.machines[0].reply_timeout_s),
             std::time::Duration::from_secs(3600)
         );
+        assert_eq!(config.file, path);
     }
 
     #[test]
