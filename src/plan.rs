@@ -8,8 +8,12 @@ use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
 
+use crate::analysis::reference::Reference;
 use crate::analysis::NominalPoint;
-use crate::config::{PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, ToleranceEntry};
+use crate::config::{
+    ConfigError, PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, StationConfig,
+    ToleranceEntry,
+};
 
 /// A teach scan stops in a sphere centred this far off its start along the start normal: where the ball
 /// centre of the station's 1 mm probe sits when it touches the start, so the scan ends as it comes back
@@ -265,6 +269,86 @@ impl Plan {
                 best
             }
         })
+    }
+}
+
+/// Refuses a clearance height (`[safety] clearance_z_mm`) that does not clear the part: travel between profiles
+/// happens at that machine z, and a teach enters each profile by a vertical move down from it, so with
+/// clearance_z_mm = 10 the teach drove its first move into blade A.
+///
+/// The clearance must be above the highest point the part is known to reach, plus the part file's
+/// `max_deviation_mm` (a real part may lie that far off its nominal), plus the largest ball the station accepts
+/// (`max_ball_radius_mm`: the machine moves the ball's centre) and the move margin. What is known: the drawing's
+/// start points of every instance's profiles, and, when `taught` is given (the part's reference, to inspect or
+/// teach again), the taught nominal points, which run round the whole of every profile. Everything is placed in
+/// machine coordinates by `plan`, which holds `station.part_to_machine`.
+///
+/// A start point lies on the surface, so a clearance below it is certainly wrong; above it the part may still
+/// rise higher between the starts (the propeller's trailing edges near the hub stand at about 83 mm over starts
+/// at 24 mm or less), which only the taught nominals show, and something that is never scanned (a hub) is
+/// known to neither. The station's inspection move check (`station::clearance`) measures descents against the
+/// taught model as well.
+pub fn check_clearance(
+    station: &StationConfig,
+    plan: &Plan,
+    taught: Option<&Reference>,
+) -> Result<(), ConfigError> {
+    let (top, what) = plan.highest_known_point(taught);
+    let safety = &station.safety;
+    let deviation = plan.part.scan.max_deviation_mm;
+    let needed = top + deviation + safety.max_ball_radius_mm + safety.move_margin_mm;
+    if safety.clearance_z_mm > needed {
+        return Ok(());
+    }
+    Err(ConfigError::Invalid {
+        path: station.file.clone(),
+        problem: format!(
+            "[safety] clearance_z_mm = {} mm does not clear part {} ({}): {what} lies at z = {top:.2} mm \
+             (machine), and with the part's [scan] max_deviation_mm = {deviation} mm, [safety] \
+             max_ball_radius_mm = {} mm and move_margin_mm = {} mm the probe needs clearance_z_mm above \
+             {needed:.2} mm. Raise clearance_z_mm above the part's highest point, or check part_to_machine",
+            safety.clearance_z_mm,
+            plan.part(),
+            station.part_path(plan.part()).display(),
+            safety.max_ball_radius_mm,
+            safety.move_margin_mm,
+        ),
+    })
+}
+
+impl Plan {
+    /// The highest machine z among the points the part is known to reach (see [`check_clearance`]), and which
+    /// point it is.
+    fn highest_known_point(&self, taught: Option<&Reference>) -> (f64, String) {
+        let mut highest = (f64::NEG_INFINITY, String::new());
+        let mut consider = |point: [f64; 3], instance: usize, what: &dyn Fn() -> String| {
+            let z = (self.placements[instance] * Point3::from(point)).z;
+            if z > highest.0 {
+                highest = (
+                    z,
+                    format!(
+                        "instance {}'s {}",
+                        self.part.instances.names[instance],
+                        what()
+                    ),
+                );
+            }
+        };
+        for instance in 0..self.placements.len() {
+            for profile in &self.part.profiles {
+                consider(profile.start_mm, instance, &|| {
+                    format!("profile {} start point", profile.name)
+                });
+            }
+            for profile in taught.iter().flat_map(|r| &r.profiles) {
+                for (k, nominal) in profile.nominals.iter().enumerate() {
+                    consider(nominal.point, instance, &|| {
+                        format!("profile {} taught nominal {k}", profile.name)
+                    });
+                }
+            }
+        }
+        highest
     }
 }
 

@@ -29,6 +29,10 @@ pub struct StationConfig {
     /// offset is one change here rather than in every part file.
     #[serde(default)]
     pub part_to_machine: Pose,
+    /// The file this was read from, for checks made later to name (a part's clearance: see
+    /// [`crate::plan::check_clearance`]); empty when not loaded from a file.
+    #[serde(skip)]
+    pub file: PathBuf,
 }
 
 /// One CMM and the line it is reached on.
@@ -41,9 +45,9 @@ pub struct MachineEntry {
     /// Bits per second of a serial line; absent for a pseudo-terminal, which has no speed.
     #[serde(default)]
     pub baud: Option<u32>,
-    /// How long a command may wait for its `&`.
+    /// How long a command may wait for its `&`; in (0, [`MAX_TIMEOUT_S`]].
     pub ack_timeout_s: f64,
-    /// The longest silence within a transaction: longer than the slowest move (homing).
+    /// The longest silence within a transaction: longer than the slowest move (homing); in (0, [`MAX_TIMEOUT_S`]].
     pub reply_timeout_s: f64,
 }
 
@@ -61,11 +65,17 @@ pub struct ProbeSettings {
     pub shank_length_mm: f64,
 }
 
+/// The longest timeout a machine may be given, s. The slowest move, homing a large CMM, takes a minute or two;
+/// an hour is far beyond any real wait, and a machine silent that long has failed. (A timeout is made a
+/// `Duration`, which holds at most about 1.8e19 s: reply_timeout_s = 1e300 panicked the worker.)
+pub(crate) const MAX_TIMEOUT_S: f64 = 3600.0;
+
 /// Limits the station keeps to so that it does not hit the part.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Safety {
-    /// The height (part frame, z) of free travel between profiles.
+    /// The height of free travel between profiles: machine z, which is the part frame's z when part_to_machine
+    /// neither raises nor tilts the part. It must clear the part ([`crate::plan::check_clearance`]).
     pub clearance_z_mm: f64,
     /// A tool whose ball is bigger than this is refused.
     pub max_ball_radius_mm: f64,
@@ -126,6 +136,7 @@ impl StationConfig {
             path: path.to_owned(),
             problem,
         })?;
+        config.file = path.to_owned();
         let folder = folder_of(path)?;
         for relative in [
             &mut config.folders.data,
@@ -204,12 +215,18 @@ impl MachineEntry {
         if self.name.trim().is_empty() {
             return Err("a [[machines]] entry has an empty name".into());
         }
-        let positive = |value: f64| value > 0.0 && value.is_finite();
-        if !(positive(self.ack_timeout_s) && positive(self.reply_timeout_s)) {
-            return Err(format!(
-                "machine {}: ack_timeout_s and reply_timeout_s must be above zero (got {} and {})",
-                self.name, self.ack_timeout_s, self.reply_timeout_s
-            ));
+        for (key, value) in [
+            ("ack_timeout_s", self.ack_timeout_s),
+            ("reply_timeout_s", self.reply_timeout_s),
+        ] {
+            if !(value > 0.0 && value <= MAX_TIMEOUT_S) {
+                return Err(format!(
+                    "machine {}: {key} = {value:?} must be above 0 and at most {MAX_TIMEOUT_S} s (an hour); \
+                     give the seconds to wait (the shipped file waits 10 s for an acknowledgement, 180 s for \
+                     a reply)",
+                    self.name
+                ));
+            }
         }
         if self.baud == Some(0) {
             return Err(format!(
@@ -363,6 +380,59 @@ mod tests {
         let (_dir, path) = edited(|t| t.replace("scanning_mm_s = 20.0", "scanning_mm_s = 0.0"));
         let message = StationConfig::load(&path).unwrap_err().to_string();
         assert!(message.contains("speeds must be above zero"), "{message}");
+    }
+
+    #[test]
+    fn a_timeout_beyond_an_hour_or_not_above_zero_is_refused_naming_the_key_and_the_range() {
+        for (from, to, key) in [
+            (
+                "reply_timeout_s = 180.0",
+                "reply_timeout_s = 1e300",
+                "reply_timeout_s = 1e300",
+            ),
+            (
+                "reply_timeout_s = 180.0",
+                "reply_timeout_s = 3600.5",
+                "reply_timeout_s = 3600.5",
+            ),
+            (
+                "ack_timeout_s = 10.0",
+                "ack_timeout_s = 0.0",
+                "ack_timeout_s = 0.0",
+            ),
+            (
+                "ack_timeout_s = 10.0",
+                "ack_timeout_s = nan",
+                "ack_timeout_s = NaN",
+            ),
+            (
+                "ack_timeout_s = 10.0",
+                "ack_timeout_s = inf",
+                "ack_timeout_s = inf",
+            ),
+        ] {
+            let (_dir, path) = edited(|t| t.replacen(from, to, 1));
+            let message = StationConfig::load(&path).unwrap_err().to_string();
+            assert!(
+                message.starts_with(&path.display().to_string()),
+                "{message}"
+            );
+            assert!(
+                message.contains(&format!(
+                    "machine cmm1: {key} must be above 0 and at most 3600 s"
+                )),
+                "{message}"
+            );
+        }
+        // The bound itself is a timeout the station can keep.
+        let (_dir, path) =
+            edited(|t| t.replacen("reply_timeout_s = 180.0", "reply_timeout_s = 3600.0", 1));
+        let config = StationConfig::load(&path).unwrap();
+        assert_eq!(
+            std::time::Duration::from_secs_f64(config.machines[0].reply_timeout_s),
+            std::time::Duration::from_secs(3600)
+        );
+        assert_eq!(config.file, path);
     }
 
     #[test]

@@ -6,7 +6,7 @@ use zeroset_sim::part::curve::SampledCurve;
 use zeroset_sim::part::propeller::Propeller;
 
 use super::*;
-use crate::config::Pose;
+use crate::config::{Pose, StationConfig};
 
 const TURN_120: (f64, f64) = (-0.5, 0.866_025_403_784_438_6);
 
@@ -294,4 +294,92 @@ fn nearest_compares_horizontal_distances_and_breaks_ties_by_key() {
     let without = [key(1, 0), key(2, 3), key(0, 0)];
     assert_eq!(plan.nearest(&without, from, starts), Some(1));
     assert_eq!(plan.nearest(&[], from, starts), None);
+}
+
+fn repo(path: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// A shipped station file, and the plan of one of its parts placed by it.
+fn shipped(station: &str, part: &str) -> (StationConfig, Plan) {
+    let station = StationConfig::load(&repo(station)).unwrap();
+    let part = PartConfig::load(&station.part_path(part)).unwrap();
+    let plan = Plan::new(&part, station.part_to_machine.isometry());
+    (station, plan)
+}
+
+#[test]
+fn the_shipped_clearance_clears_the_shipped_parts_and_10_mm_is_refused_with_the_height_needed() {
+    // The propeller's highest start is r100's at z = 23.98 mm; the nut, stood up, has its part x up, so its
+    // highest start is h19's at z = 19 mm. Each plus max_deviation_mm (3 and 1 mm), the 1.5 mm ball and the
+    // 0.5 mm margin.
+    for (file, part, highest, needed) in [
+        (
+            "config/station.toml",
+            "propeller",
+            "instance A's profile r100 start point lies at z = 23.98 mm",
+            28.98,
+        ),
+        (
+            "config/station-nut.toml",
+            "nut",
+            "instance nut's profile h19 start point lies at z = 19.00 mm",
+            22.0,
+        ),
+    ] {
+        let (mut station, plan) = shipped(file, part);
+        assert_eq!(station.safety.clearance_z_mm, 150.0);
+        check_clearance(&station, &plan, None).unwrap();
+        station.safety.clearance_z_mm = 10.0;
+        let message = check_clearance(&station, &plan, None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.starts_with(&repo(file).display().to_string()),
+            "{message}"
+        );
+        assert!(
+            message.contains(&format!(
+                "[safety] clearance_z_mm = 10 mm does not clear part {part} ({})",
+                station.part_path(part).display()
+            )),
+            "{message}"
+        );
+        assert!(message.contains(highest), "{message}");
+        assert!(
+            message.contains(&format!("needs clearance_z_mm above {needed:.2} mm")),
+            "{message}"
+        );
+        // Just below the height needed is refused, just above it accepted.
+        station.safety.clearance_z_mm = needed - 0.01;
+        assert!(check_clearance(&station, &plan, None).is_err());
+        station.safety.clearance_z_mm = needed + 0.01;
+        check_clearance(&station, &plan, None).unwrap();
+    }
+    // Lying flat (the propeller's station), the nut's starts are on its underside: the shipped height clears.
+    let (station, plan) = shipped("config/station.toml", "nut");
+    check_clearance(&station, &plan, None).unwrap();
+}
+
+#[test]
+fn taught_nominals_above_the_start_points_raise_the_height_needed() {
+    let (mut station, plan) = shipped("config/station.toml", "propeller");
+    let mut reference = crate::analysis::test_profiles::taught_ellipses().clone();
+    // A trailing edge that stands up near the hub, as the propeller's do: taught, not in the drawing.
+    reference.profiles[0].nominals[5].point = [100.0, -40.0, 83.0];
+    station.safety.clearance_z_mm = 60.0;
+    check_clearance(&station, &plan, None).unwrap();
+    let message = check_clearance(&station, &plan, Some(&reference))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("instance A's profile x100 taught nominal 5 lies at z = 83.00 mm"),
+        "{message}"
+    );
+    assert!(
+        message.contains("needs clearance_z_mm above 88.00 mm"),
+        "{message}"
+    );
+    station.safety.clearance_z_mm = 88.5;
+    check_clearance(&station, &plan, Some(&reference)).unwrap();
 }

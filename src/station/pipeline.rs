@@ -5,7 +5,8 @@
 //! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done.
 //! Points whose contact compensation flags (a cusp: the surface more concave than the ball) are published and
 //! recorded but left out of the profile's statistics and verdict, and counted in the log. The queue from the
-//! workers is bounded, so analysis that falls behind slows scanning down rather than losing points.
+//! workers is bounded, so analysis that falls behind slows scanning down rather than losing points; so is the
+//! recorder's, which the analysis waits on, so a disk that falls behind slows scanning down the same way.
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
@@ -78,7 +79,7 @@ struct Active<'g> {
 }
 
 impl Pipeline {
-    pub async fn run(self, mut inbox: mpsc::Receiver<PipelineMsg>) {
+    pub async fn run(self, inbox: mpsc::Receiver<PipelineMsg>) {
         let recorder = Recorder {
             job: self.job.clone(),
             dir: self.dir.clone(),
@@ -86,11 +87,17 @@ impl Pipeline {
             daemon: self.daemon.clone(),
         }
         .spawn();
+        self.analyse(inbox, recorder).await;
+    }
+
+    /// The analysis itself, writing through `recorder`.
+    async fn analyse(self, mut inbox: mpsc::Receiver<PipelineMsg>, recorder: mpsc::Sender<Record>) {
         let gauges = self.gauges.clone();
         let mut active: HashMap<ProfileKey, Active<'_>> = HashMap::new();
         while let Some(message) = inbox.recv().await {
             // The recorder lives as long as this task; a send fails only if its thread panicked, which the
-            // daemon learns from the profiles that never count as done.
+            // daemon learns from the profiles that never count as done. A send waits while the recorder's queue
+            // is full: the disk's back-pressure reaches the workers through this task's own bounded queue.
             match message {
                 PipelineMsg::Start {
                     key,
@@ -104,11 +111,13 @@ impl Pipeline {
                         started: clock::now_rfc3339(),
                     };
                     let scan = self.scan_ref(key);
-                    let _ = recorder.send(Record::Start {
-                        key,
-                        scan,
-                        header: header.clone(),
-                    });
+                    let _ = recorder
+                        .send(Record::Start {
+                            key,
+                            scan,
+                            header: header.clone(),
+                        })
+                        .await;
                     let machine_to_part = self.plan.instance_to_machine(key.instance).inverse();
                     let compensator = Compensator::new(
                         CompensationSettings::new(ball_radius_mm),
@@ -144,7 +153,7 @@ impl Pipeline {
                     };
                     profile.points.push(raw);
                     profile.waiting.push_back(received_us);
-                    let _ = recorder.send(Record::Point { key, raw });
+                    let _ = recorder.send(Record::Point { key, raw }).await;
                     let centre = Point3::from(raw.centre);
                     if let Some(point) = profile.compensator.push(centre, Vector3::from(raw.normal))
                     {
@@ -155,12 +164,14 @@ impl Pipeline {
                     if let Some(mut profile) = active.remove(&key) {
                         self.publish_rest(key, &mut profile);
                         let stats = profile.stats.summary();
-                        let _ = recorder.send(Record::End {
-                            key,
-                            points: profile.points,
-                            verdict: stats.map(|s| self.tolerance.verdict(&s, profile.outside)),
-                            stats,
-                        });
+                        let _ = recorder
+                            .send(Record::End {
+                                key,
+                                points: profile.points,
+                                verdict: stats.map(|s| self.tolerance.verdict(&s, profile.outside)),
+                                stats,
+                            })
+                            .await;
                     }
                 }
                 PipelineMsg::Cut { key } => {
@@ -169,7 +180,7 @@ impl Pipeline {
                     if let Some(mut profile) = active.remove(&key) {
                         self.publish_rest(key, &mut profile);
                     }
-                    let _ = recorder.send(Record::Cut { key });
+                    let _ = recorder.send(Record::Cut { key }).await;
                 }
             }
         }
@@ -254,6 +265,8 @@ pub fn scan_ref(plan: &Plan, key: ProfileKey) -> ScanRef {
 #[cfg(test)]
 mod tests {
     use std::path::Path;
+    use std::sync::{Condvar, Mutex};
+    use std::time::Duration;
 
     use nalgebra::Isometry3;
 
@@ -262,9 +275,16 @@ mod tests {
     use crate::analysis::test_profiles::{taught_ellipses, Ellipse};
     use crate::api::JobKind;
     use crate::config::PartConfig;
-    use crate::station::journal::{JobRecord, JobState};
+    use crate::station::journal::{JobRecord, JobState, PartialScan, ScanFile};
+    use crate::station::recorder::{Disk, Partial, RECORDER_QUEUE};
 
     const BALL: f64 = 1.0;
+
+    /// Instance A's profile r300.
+    const KEY: ProfileKey = ProfileKey {
+        instance: 0,
+        profile: 2,
+    };
 
     /// A point event's fields the tests look at.
     struct PointEvent {
@@ -282,14 +302,11 @@ mod tests {
         stats: Option<DeviationStats>,
     }
 
-    /// Runs a pipeline on the propeller's plan (master at the machine's origin) over one scan of instance A's
-    /// profile `profile`: `Start`, the raw points (each received at 1000 + its index us), then `last`.
-    async fn run(
-        profile: usize,
+    /// A pipeline on the propeller's plan (master at the machine's origin), its job's folder in a temporary
+    /// data folder (kept while the folder is), and a receiver of its events.
+    fn propeller_pipeline(
         gauges: Option<Arc<Vec<ProfileGauge>>>,
-        raws: &[RawPoint],
-        last: fn(ProfileKey) -> PipelineMsg,
-    ) -> Published {
+    ) -> (Pipeline, tempfile::TempDir, broadcast::Receiver<Event>) {
         let part = PartConfig::load(
             &Path::new(env!("CARGO_MANIFEST_DIR")).join("config/parts/propeller.toml"),
         )
@@ -307,7 +324,7 @@ mod tests {
             rescans: Vec::new(),
         };
         let dir = JobDir::create(data.path(), &record).unwrap();
-        let (events, mut watch) = broadcast::channel(4 * QUEUE_POINTS);
+        let (events, watch) = broadcast::channel(4 * QUEUE_POINTS);
         let (daemon, _daemon_inbox) = mpsc::channel(16);
         let pipeline = Pipeline {
             job: record.id.clone(),
@@ -321,6 +338,18 @@ mod tests {
             events,
             daemon,
         };
+        (pipeline, data, watch)
+    }
+
+    /// Runs a pipeline on the propeller's plan over one scan of instance A's profile `profile`: `Start`, the raw
+    /// points (each received at 1000 + its index us), then `last`.
+    async fn run(
+        profile: usize,
+        gauges: Option<Arc<Vec<ProfileGauge>>>,
+        raws: &[RawPoint],
+        last: fn(ProfileKey) -> PipelineMsg,
+    ) -> Published {
+        let (pipeline, _data, mut watch) = propeller_pipeline(gauges);
         let (to_pipeline, inbox) = mpsc::channel(QUEUE_POINTS);
         tokio::spawn(pipeline.run(inbox));
         let key = ProfileKey {
@@ -463,5 +492,146 @@ mod tests {
             let expected = Point3::from(raw.centre) - Vector3::from(raw.normal) * BALL;
             assert!((Point3::from(point.surface) - expected).norm() < 1e-12);
         }
+    }
+
+    /// A disk whose point writes wait while `stalled` holds, and which notes every point it writes.
+    #[derive(Clone)]
+    struct StallingDisk {
+        dir: JobDir,
+        stalled: Arc<(Mutex<bool>, Condvar)>,
+        written: Arc<Mutex<Vec<RawPoint>>>,
+    }
+
+    impl StallingDisk {
+        fn release(&self) {
+            let (stalled, changed) = &*self.stalled;
+            *stalled.lock().unwrap() = false;
+            changed.notify_all();
+        }
+    }
+
+    struct StallingPartial {
+        file: PartialScan,
+        disk: StallingDisk,
+    }
+
+    impl Disk for StallingDisk {
+        type Partial = StallingPartial;
+
+        fn start_partial(
+            &self,
+            scan: &ScanRef,
+            header: &ScanHeader,
+        ) -> std::io::Result<StallingPartial> {
+            Ok(StallingPartial {
+                file: self.dir.start_partial(scan, header)?,
+                disk: self.clone(),
+            })
+        }
+
+        fn write_scan(&self, scan: &ScanRef, file: &ScanFile) -> std::io::Result<()> {
+            self.dir.write_scan(scan, file)
+        }
+    }
+
+    impl Partial for StallingPartial {
+        fn push(&mut self, point: &RawPoint) -> std::io::Result<()> {
+            let (stalled, changed) = &*self.disk.stalled;
+            let mut waiting = stalled.lock().unwrap();
+            while *waiting {
+                waiting = changed.wait(waiting).unwrap();
+            }
+            self.disk.written.lock().unwrap().push(*point);
+            self.file.push(point)
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            self.file.flush()
+        }
+    }
+
+    /// The queues are measured, not assumed: while the disk stalls the worker's sends stop once the queues are
+    /// full, then every point reaches the disk in order.
+    #[tokio::test]
+    async fn a_stalled_disk_makes_the_worker_wait_and_every_point_is_written_in_order() {
+        let (pipeline, _data, mut watch) = propeller_pipeline(None);
+        let disk = StallingDisk {
+            dir: pipeline.dir.clone(),
+            stalled: Arc::new((Mutex::new(true), Condvar::new())),
+            written: Arc::default(),
+        };
+        let recorder = Recorder {
+            job: pipeline.job.clone(),
+            dir: disk.clone(),
+            events: pipeline.events.clone(),
+            daemon: pipeline.daemon.clone(),
+        }
+        .spawn();
+        let scan = pipeline.scan_ref(KEY);
+        let (to_pipeline, inbox) = mpsc::channel(QUEUE_POINTS);
+        tokio::spawn(pipeline.analyse(inbox, recorder));
+
+        // Ball centres round a circle in the plane of profile r300, more than both queues hold.
+        let count = QUEUE_POINTS + RECORDER_QUEUE + 500;
+        let raws: Vec<RawPoint> = (0..count)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / count as f64;
+                let normal = [0.0, t.cos(), t.sin()];
+                RawPoint {
+                    centre: [300.0, 1000.0 * normal[1], 1000.0 * normal[2]],
+                    normal,
+                    quality: 1.0,
+                }
+            })
+            .collect();
+        let point = |i: usize| PipelineMsg::Point {
+            key: KEY,
+            raw: raws[i],
+            received_us: i as u64,
+        };
+        let start = PipelineMsg::Start {
+            key: KEY,
+            machine: "cmm1".into(),
+            ball_radius_mm: BALL,
+            entry: Point3::from(raws[0].centre),
+        };
+        to_pipeline.send(start).await.unwrap();
+        // The worker sends until a send has waited a second; a permit is reserved first, so no point is lost.
+        let mut sent = 0;
+        while sent < count {
+            match tokio::time::timeout(Duration::from_secs(1), to_pipeline.reserve()).await {
+                Ok(permit) => {
+                    permit.unwrap().send(point(sent));
+                    sent += 1;
+                }
+                Err(_) => break,
+            }
+        }
+        // Taken while the disk stalls: the pipeline's queue, the recorder's, the point the disk is writing and
+        // the one the analysis waits to hand on; nothing else is held.
+        assert_eq!(sent, QUEUE_POINTS + RECORDER_QUEUE + 2);
+        assert!(disk.written.lock().unwrap().is_empty());
+
+        disk.release();
+        for i in sent..count {
+            to_pipeline.send(point(i)).await.unwrap();
+        }
+        to_pipeline
+            .send(PipelineMsg::End { key: KEY })
+            .await
+            .unwrap();
+        let done = async {
+            loop {
+                if let Event::ProfileDone { points, .. } = watch.recv().await.unwrap() {
+                    return points;
+                }
+            }
+        };
+        let announced = tokio::time::timeout(Duration::from_secs(60), done)
+            .await
+            .expect("the profile is announced done once its scan is written");
+        assert_eq!(announced, count);
+        assert!(*disk.written.lock().unwrap() == raws);
+        assert!(disk.dir.read_scan(&scan).unwrap().points == raws);
     }
 }

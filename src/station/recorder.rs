@@ -2,8 +2,13 @@
 //! as it comes (a killed daemon keeps it); a finished profile's scan file is written and flushed, and only then is
 //! the profile announced done and counted. Opening files and flushing them to the disk take milliseconds, which
 //! the live deviations must not wait for, so none of it happens on the analysis task.
+//!
+//! The queue to the recorder is bounded ([`RECORDER_QUEUE`]): a disk that stalls for longer than it holds makes
+//! the analysis wait at its send, the analysis' own bounded queue then makes the machine workers wait, and no
+//! queue grows without end.
 
 use std::collections::HashMap;
+use std::io;
 
 use tokio::sync::{broadcast, mpsc};
 
@@ -14,6 +19,12 @@ use crate::analysis::stats::{DeviationStats, Verdict};
 use crate::analysis::RawPoint;
 use crate::api::{Event, ScanRef};
 use crate::plan::ProfileKey;
+
+/// Records waiting for the recorder: some 10 s of points from five machines scanning 20 points a second, far
+/// longer than a healthy disk ever keeps it waiting (a file is opened or flushed in milliseconds). A record
+/// takes 152 bytes in the queue (a scan's points at its end are on the heap, one scan per profile), so the queue
+/// holds about 160 kB.
+pub(crate) const RECORDER_QUEUE: usize = 1024;
 
 /// What the analysis asks the recorder to write, in the order the points came.
 pub enum Record {
@@ -39,25 +50,60 @@ pub enum Record {
     },
 }
 
+/// Where the recorder writes: the job's folder, or in tests a disk that stalls.
+pub(crate) trait Disk: Send + 'static {
+    type Partial: Partial;
+    fn start_partial(&self, scan: &ScanRef, header: &ScanHeader) -> io::Result<Self::Partial>;
+    fn write_scan(&self, scan: &ScanRef, file: &ScanFile) -> io::Result<()>;
+}
+
+/// The partial file of the profile being scanned.
+pub(crate) trait Partial: Send {
+    fn push(&mut self, point: &RawPoint) -> io::Result<()>;
+    fn flush(&mut self) -> io::Result<()>;
+}
+
+impl Disk for JobDir {
+    type Partial = PartialScan;
+
+    fn start_partial(&self, scan: &ScanRef, header: &ScanHeader) -> io::Result<PartialScan> {
+        JobDir::start_partial(self, scan, header)
+    }
+
+    fn write_scan(&self, scan: &ScanRef, file: &ScanFile) -> io::Result<()> {
+        JobDir::write_scan(self, scan, file)
+    }
+}
+
+impl Partial for PartialScan {
+    fn push(&mut self, point: &RawPoint) -> io::Result<()> {
+        PartialScan::push(self, point)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        PartialScan::flush(self)
+    }
+}
+
 /// Where the recorder reports.
-pub struct Recorder {
+pub struct Recorder<D = JobDir> {
     pub job: String,
-    pub dir: JobDir,
+    pub dir: D,
     pub events: broadcast::Sender<Event>,
     pub daemon: mpsc::Sender<DaemonMsg>,
 }
 
-struct Open {
+struct Open<P> {
     scan: ScanRef,
     header: ScanHeader,
     /// `None` once a write failed: the failure was reported, the rest of the scan is not written.
-    partial: Option<PartialScan>,
+    partial: Option<P>,
 }
 
-impl Recorder {
+impl<D: Disk> Recorder<D> {
     /// Starts the recorder's thread; it ends when the sender is dropped and everything sent is written.
-    pub fn spawn(self) -> mpsc::UnboundedSender<Record> {
-        let (records, inbox) = mpsc::unbounded_channel();
+    pub fn spawn(self) -> mpsc::Sender<Record> {
+        let (records, inbox) = mpsc::channel(RECORDER_QUEUE);
         std::thread::Builder::new()
             .name(format!("recorder {}", self.job))
             .spawn(move || self.run(inbox))
@@ -65,8 +111,8 @@ impl Recorder {
         records
     }
 
-    fn run(self, mut inbox: mpsc::UnboundedReceiver<Record>) {
-        let mut open: HashMap<ProfileKey, Open> = HashMap::new();
+    fn run(self, mut inbox: mpsc::Receiver<Record>) {
+        let mut open: HashMap<ProfileKey, Open<D::Partial>> = HashMap::new();
         loop {
             // Points are written in batches: whatever came together goes out in one write once nothing more is
             // waiting (a scan's points come a line of several at a time).
@@ -115,7 +161,7 @@ impl Recorder {
                     verdict,
                 } => {
                     if let Some(mut scan) = open.remove(&key) {
-                        if let Some(Err(error)) = scan.partial.as_mut().map(PartialScan::flush) {
+                        if let Some(Err(error)) = scan.partial.as_mut().map(Partial::flush) {
                             scan.partial = None;
                             self.failed(key, error.to_string());
                         }
@@ -136,9 +182,9 @@ impl Recorder {
     }
 
     /// Hands every open scan's buffered points to the operating system.
-    fn flush(&self, open: &mut HashMap<ProfileKey, Open>) {
+    fn flush(&self, open: &mut HashMap<ProfileKey, Open<D::Partial>>) {
         for (key, scan) in open.iter_mut() {
-            if let Some(Err(error)) = scan.partial.as_mut().map(PartialScan::flush) {
+            if let Some(Err(error)) = scan.partial.as_mut().map(Partial::flush) {
                 scan.partial = None;
                 self.failed(*key, error.to_string());
             }
@@ -148,7 +194,7 @@ impl Recorder {
     fn complete(
         &self,
         key: ProfileKey,
-        scan: Open,
+        scan: Open<D::Partial>,
         points: Vec<RawPoint>,
         stats: Option<DeviationStats>,
         verdict: Option<Verdict>,

@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use super::{Reference, ReferenceSettings, FORMAT, UNITS, VERSION};
+use nalgebra::Vector3;
+
+use super::{NominalPoint, Reference, ReferenceSettings, FORMAT, UNITS, VERSION};
 use crate::fsutil::write_atomically;
 use crate::model_file::{self, stack_of, FittedIp, ReferenceModel};
 
@@ -32,7 +34,8 @@ impl Reference {
     }
 
     /// Loads a reference and checks that it can be measured against as it was taught: format, version, units,
-    /// and a model whose profiles match the reference's and blend into a stack.
+    /// nominals that can be scanned along, and a model whose profiles match the reference's and blend into a
+    /// stack.
     pub fn load(path: &Path) -> Result<Self, ReferenceFileError> {
         let shown = || path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| ReferenceFileError::Read {
@@ -78,6 +81,15 @@ impl Reference {
                 model_file::VERSION
             ));
         }
+        for (i, taught) in self.profiles.iter().enumerate() {
+            let at = format!("profile {i} '{}' (x = {} mm)", taught.name, taught.x_mm);
+            if taught.nominals.is_empty() {
+                return Err(format!("{at} has no nominal points to scan along"));
+            }
+            for (k, nominal) in taught.nominals.iter().enumerate() {
+                check_nominal(nominal).map_err(|e| format!("{at}, nominal {k}: {e}"))?;
+            }
+        }
         let profiles = match (&self.model.model, &self.settings) {
             (ReferenceModel::Stack { profiles }, ReferenceSettings::ImplicitPolynomial { .. }) => {
                 profiles
@@ -113,6 +125,25 @@ impl Reference {
         stack_of(profiles).map_err(|e| e.to_string())?;
         Ok(())
     }
+}
+
+/// How far a nominal's normal may be from unit length. The teach writes unit normals, which JSON keeps to the
+/// last bit; this leaves room for a hand-edited file's seven decimals. The scans offset the probe along the
+/// normals as they are, so one 1e-6 off unit moves a 6 mm offset by 6 nm.
+const UNIT_NORMAL_TOLERANCE: f64 = 1e-6;
+
+/// A nominal the station can scan along has a unit normal (its numbers are finite: JSON has no others). A zero
+/// normal was accepted once and made every move off the surface NaN.
+fn check_nominal(nominal: &NominalPoint) -> Result<(), String> {
+    let normal = Vector3::from(nominal.normal);
+    if (normal.norm() - 1.0).abs() > UNIT_NORMAL_TOLERANCE {
+        return Err(format!(
+            "normal {:?} is not a unit vector (length {})",
+            nominal.normal,
+            normal.norm()
+        ));
+    }
+    Ok(())
 }
 
 /// What a profile model must satisfy to be evaluated: a positive scale, a polynomial that is not identically

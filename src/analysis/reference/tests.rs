@@ -114,6 +114,26 @@ fn a_reference_file_that_does_not_match_is_refused_by_what_is_wrong() {
         }
     });
     assert!(error.contains("settings.kind \"supershape\""), "{error}");
+    // Nominals the scans cannot follow: a zero normal, one that is not unit, none at all.
+    let error = refuse(&|r| r.profiles[2].nominals[17].normal = [0.0, 0.0, 0.0]);
+    assert!(
+        error.contains("bad-reference.json")
+            && error.contains("profile 2 'x300' (x = 300 mm), nominal 17: normal [0.0, 0.0, 0.0] is not a unit vector (length 0)")
+            && error.ends_with("teach the reference again"),
+        "{error}"
+    );
+    let error = refuse(&|r| r.profiles[0].nominals[3].normal = [0.0, 0.6, 0.6]);
+    assert!(
+        error.contains(
+            "profile 0 'x100' (x = 100 mm), nominal 3: normal [0.0, 0.6, 0.6] is not a unit vector"
+        ),
+        "{error}"
+    );
+    let error = refuse(&|r| r.profiles[4].nominals.clear());
+    assert!(
+        error.contains("profile 4 'x500' (x = 500 mm) has no nominal points"),
+        "{error}"
+    );
     std::fs::write(&path, "{\"format\": \"zeroset-reference\"").unwrap();
     let error = Reference::load(&path).unwrap_err();
     assert!(matches!(error, ReferenceFileError::Parse { .. }), "{error}");
@@ -215,4 +235,19 @@ fn teaching_refuses_what_cannot_make_a_reference() {
         teach("p", &profiles, &no_spacing).unwrap_err(),
         TeachError::BadSpacing { .. }
     ));
+}
+
+/// The part files' bound on the degree is one the teach can do: above it the fit panicked.
+#[test]
+fn the_highest_degree_a_part_file_may_give_teaches() {
+    let settings = ReferenceSettings::ImplicitPolynomial {
+        degree: crate::config::part::MAX_REFERENCE_DEGREE,
+        method: FitMethod::Orthogonal,
+        nominal_spacing_mm: 5.0,
+    };
+    let reference = teach("ellipse-blade", &masters(), &settings).expect("degree 14 teaches");
+    let ReferenceModel::Stack { profiles } = &reference.model.model else {
+        panic!("not a stack");
+    };
+    assert!(profiles.iter().all(|p| p.fitted.ip.poly.degree() == 14));
 }
