@@ -288,7 +288,7 @@ impl Plan {
 /// at 24 mm or less), which only the taught nominals show, and something that is never scanned (a hub) is
 /// known to neither. The station's inspection move check (`station::clearance`) measures descents against the
 /// taught model as well.
-pub fn check_clearance(
+pub(crate) fn check_clearance(
     station: &StationConfig,
     plan: &Plan,
     taught: Option<&Reference>,

@@ -582,16 +582,33 @@ impl Core {
                 }
             }
             Err(error) => {
-                job.record.state = JobState::Failed {
-                    error: error.clone(),
+                // Every scan is on disk and stays counted: once the cause is removed (a reports folder that
+                // cannot be written, a full disk) the job is finished from them, without scanning again.
+                let what = match job.info.kind {
+                    JobKind::Teach => "fitting its reference",
+                    JobKind::Inspect => "writing its report",
                 };
-                job.phase = JobPhase::Failed {
-                    error: error.clone(),
+                let reason =
+                    format!("job {job_id}: every profile is on disk, but {what} failed: {error}");
+                let next_step = "remove the cause, then run `zeroset clear` to finish it from its scans (nothing \
+                                 is scanned again), or `zeroset abort` to end it"
+                    .to_string();
+                tracing::error!(job = job_id, %reason, "job stopped");
+                job.phase = JobPhase::Stopped {
+                    machine: None,
+                    scan: None,
+                    reason: reason.clone(),
+                    next_step: next_step.clone(),
                 };
-                Event::JobFailed {
+                let event = Event::JobStopped {
                     job: job_id.to_string(),
-                    error,
-                }
+                    machine: None,
+                    scan: None,
+                    reason,
+                    next_step,
+                };
+                self.publish(event);
+                return;
             }
         };
         tracing::info!(job = job_id, phase = %job.phase, "job over");

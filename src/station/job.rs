@@ -106,6 +106,7 @@ fn plan_moves(
     kind: JobKind,
     reference: Option<&Reference>,
 ) -> Result<PlannedMoves, JobError> {
+    crate::plan::check_clearance(config, plan, reference).map_err(|e| JobError(e.to_string()))?;
     let keys = job_scans(plan, kind);
     let motions = job_motions(plan, reference, &keys, &config.safety).map_err(|e| {
         JobError(format!(

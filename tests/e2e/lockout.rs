@@ -185,3 +185,23 @@ fn an_emergency_stop_anywhere_in_a_teach_scan_is_cleared_without_a_collision_and
     );
     assert_eq!(stops, 3);
 }
+
+#[test]
+fn a_clearance_height_inside_the_part_is_refused_before_anything_moves() {
+    let station = Station::start_edited("propeller.toml", "station.toml", |table| {
+        let safety = table["safety"].as_table_mut().unwrap();
+        safety.insert("clearance_z_mm".into(), 10.0.into());
+    });
+    let run = station.cli(&["teach", "propeller"]);
+    assert!(
+        !run.success && run.stderr.contains("clearance_z_mm"),
+        "{}{}",
+        run.stdout,
+        run.stderr
+    );
+    let sent = std::fs::read_to_string(station.sim.transcript("cmm1")).unwrap_or_default();
+    assert!(
+        !MOTION_OR_CLEAR.iter().any(|m| sent.contains(m)),
+        "the machine was moved:\n{sent}"
+    );
+}

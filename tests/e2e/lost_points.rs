@@ -59,3 +59,94 @@ fn a_scan_that_lost_a_line_of_points_is_scanned_again_to_its_full_count() {
         eprintln!("{serial}: line lost after point {at}: {rescans} rescan(s)");
     }
 }
+
+#[test]
+fn a_report_that_cannot_be_written_waits_for_the_fix_and_is_written_from_the_scans() {
+    let station = crate::daemon::Station::start("propeller.toml").with_taught_reference();
+    // The part's reports folder is a file: the report cannot be written (a read-only folder stops nobody who
+    // runs as root, as CI does).
+    std::fs::create_dir_all(station.reports()).unwrap();
+    let blocked = station.reports().join("propeller");
+    std::fs::write(&blocked, "not a folder").unwrap();
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-RO", "--detach"]);
+    let stopped = watcher.until(120, |e| {
+        job_over(e) || matches!(e, Event::JobStopped { .. })
+    });
+    let Event::JobStopped {
+        reason, next_step, ..
+    } = stopped
+    else {
+        panic!("{stopped:?}")
+    };
+    assert!(reason.contains("every profile is on disk"), "{reason}");
+    assert!(next_step.contains("zeroset clear"), "{next_step}");
+    std::fs::remove_file(&blocked).unwrap();
+    let seen = watcher.events().len();
+    station.cli_ok(&["clear"]);
+    let end = watcher.until(120, job_over);
+    assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
+    let rescanned = watcher.events()[seen..]
+        .iter()
+        .filter(|e| matches!(e, Event::ScanStarted { .. }))
+        .count();
+    assert_eq!(rescanned, 0, "the report is written from the scans on disk");
+    let (dir, report) = station.report("SN-RO");
+    assert!(dir.join("report.json").is_file());
+    assert_eq!(report.instances.len(), 3);
+}
+
+#[test]
+fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_other() {
+    let mut station = station();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    let (_, whole) = station.report("SN-WHOLE");
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-T", "--detach"]);
+    let mut done = Vec::new();
+    let mut job = String::new();
+    watcher.until(60, |e| {
+        if let Event::ProfileDone { scan, job: id, .. } = e {
+            done.push(scan.clone());
+            job = id.clone();
+        }
+        done.len() >= 3 && matches!(e, Event::Point { index: 30, .. })
+    });
+    drop(watcher);
+    station.kill_daemon();
+    let spoiled = &done[1];
+    let file = station
+        .data()
+        .join("jobs")
+        .join(&job)
+        .join("scans")
+        .join(format!("{}-{}.json", spoiled.instance, spoiled.profile));
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::write(&file, &bytes[..bytes.len() / 3]).unwrap();
+    station.start_daemon();
+    let mut watcher = station.watch();
+    station.cli_ok(&["clear"]);
+    let end = watcher.until(120, job_over);
+    assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
+    let scanned: Vec<_> = watcher
+        .events()
+        .into_iter()
+        .filter_map(|e| match e {
+            Event::ScanStarted { scan, .. } => Some(scan),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        scanned.contains(spoiled),
+        "{spoiled:?} scanned again: {scanned:?}"
+    );
+    for good in done.iter().filter(|d| *d != spoiled) {
+        assert!(
+            !scanned.contains(good),
+            "{good:?} was whole on disk but scanned again"
+        );
+    }
+    let (_, report) = station.report("SN-T");
+    assert_eq!(point_counts(&report), point_counts(&whole));
+    assert_no_repeated_points(&report);
+}

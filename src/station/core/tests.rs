@@ -381,19 +381,52 @@ fn clear_resumes_a_stopped_job_where_it_stopped_and_the_job_then_finishes() {
 }
 
 #[test]
-fn a_failed_finish_ends_the_job_and_frees_the_station() {
+fn a_failed_finish_stops_the_job_and_clear_finishes_it_from_its_scans() {
     let mut bench = Bench::new();
-    bench.start_teach();
+    let first = scanned(&bench.start_teach()).unwrap();
     let job_id = bench.core.job().unwrap().info.id.clone();
+    let total = bench.core.job().unwrap().total;
+    let mut key = first;
+    for _ in 0..total {
+        bench.core.handle(Input::Stored {
+            job: job_id.clone(),
+            key,
+            result: Ok(()),
+        });
+        if let Some(next) = scanned(&bench.scan_ended(key, Ok(()))) {
+            key = next;
+        }
+    }
+    assert_eq!(bench.phase(), JobPhase::Finishing);
     let effects = bench.core.handle(Input::Finished {
-        job: job_id,
-        result: Err("finishing the job failed inside the station (panic)".into()),
+        job: job_id.clone(),
+        result: Err("cannot create reports/propeller: Not a directory".into()),
     });
-    assert!(published(&effects, |e| matches!(
-        e,
-        Event::JobFailed { .. }
-    )));
-    assert!(matches!(bench.phase(), JobPhase::Failed { .. }));
+    assert!(published(
+        &effects,
+        |e| matches!(e, Event::JobStopped { next_step, .. } if next_step.contains("nothing is scanned again"))
+    ));
+    assert!(matches!(bench.phase(), JobPhase::Stopped { .. }));
+    assert!(
+        !effects
+            .iter()
+            .any(|e| matches!(e, Effect::SaveRecord { .. })),
+        "the job stays open on disk"
+    );
+    bench.request(Request::Clear);
+    let effects = bench.core.handle(Input::Cleared {
+        machine: MACHINE.into(),
+        result: Ok(()),
+    });
+    assert_eq!(scanned(&effects), None, "no profile is scanned again");
+    assert_eq!(
+        effects
+            .iter()
+            .filter(|e| matches!(e, Effect::Finish))
+            .count(),
+        1,
+        "finished again from the scans on disk"
+    );
 }
 
 #[test]
