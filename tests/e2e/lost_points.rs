@@ -150,3 +150,30 @@ fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_oth
     assert_eq!(point_counts(&report), point_counts(&whole));
     assert_no_repeated_points(&report);
 }
+
+#[test]
+fn a_lost_line_then_clear_reconnects_and_the_job_continues_whole() {
+    let mut station = station();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    let (_, whole) = station.report("SN-WHOLE");
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-LINK", "--detach"]);
+    watcher.until(60, |e| matches!(e, Event::Point { index: 50, .. }));
+    assert_eq!(
+        station.sim.control("fault cmm1 disconnect 1000"),
+        "ok fault cmm1 disconnect 1000"
+    );
+    let stopped = watcher.until(30, |e| matches!(e, Event::JobStopped { .. }));
+    let Event::JobStopped { reason, .. } = stopped else {
+        unreachable!()
+    };
+    assert!(reason.contains("cmm1"), "{reason}");
+    std::thread::sleep(std::time::Duration::from_millis(1200));
+    let cleared = station.cli_ok(&["clear"]);
+    assert!(cleared.contains("continues"), "{cleared}");
+    let end = watcher.until(120, job_over);
+    assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
+    let (_, report) = station.report("SN-LINK");
+    assert_eq!(point_counts(&report), point_counts(&whole));
+    assert_no_repeated_points(&report);
+}

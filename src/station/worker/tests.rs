@@ -173,6 +173,20 @@ fn xyz_of(p: &Point3<f64>) -> Xyz {
     Xyz::new(p.x, p.y, p.z)
 }
 
+/// A whole scan round the circle: the 1 mm ball on it at every nominal, the top first.
+fn whole_circle() -> Vec<ScanPoint> {
+    let path = circle();
+    path.surface
+        .iter()
+        .zip(&path.normals)
+        .map(|(p, n)| ScanPoint {
+            centre: Xyz::new(p.x + n.x, p.y + n.y, p.z + n.z),
+            normal: Xyz::new(n.x, n.y, n.z),
+            quality: 0.0,
+        })
+        .collect()
+}
+
 fn point(z: f64) -> ScanPoint {
     ScanPoint {
         centre: Xyz::new(100.0, 0.0, z),
@@ -200,9 +214,9 @@ async fn a_scan_sends_exactly_its_planned_motion_which_is_what_the_clearance_che
     let moves = Arc::new(Mutex::new(Vec::new()));
     // Homed at z = 400 before; at the end of the closed scan back over the top, the 1 mm ball in contact.
     let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
-    let scanned = vec![point(21.0), point(21.001), point(20.999)];
+    let scanned = whole_circle();
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned.clone()));
-    let (pipeline, mut analysis) = mpsc::channel(16);
+    let (pipeline, mut analysis) = mpsc::channel(128);
     worker
         .orders
         .send(scan_order(motion.clone(), pipeline))
@@ -506,4 +520,43 @@ async fn a_clear_on_a_session_the_machine_lost_starts_it_again() {
     }
     // The first clear opens the session; the second finds it lost (0008) and opens it again.
     assert_eq!(*sessions.lock().unwrap(), 2);
+}
+
+#[tokio::test]
+async fn a_scan_with_a_hole_is_cut_not_counted_and_the_probe_still_leaves_as_planned() {
+    let motion = motion();
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
+    let mut scanned = whole_circle();
+    scanned.drain(20..30);
+    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned));
+    let (pipeline, mut analysis) = mpsc::channel(128);
+    worker
+        .orders
+        .send(scan_order(motion.clone(), pipeline))
+        .await
+        .unwrap();
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Gap, "{}", error.message);
+    assert!(
+        error.message.contains("after point 19"),
+        "{}",
+        error.message
+    );
+    let planned: Vec<Xyz> = motion
+        .approach
+        .iter()
+        .chain(&motion.retract)
+        .map(xyz_of)
+        .collect();
+    assert_eq!(
+        *moves.lock().unwrap(),
+        planned,
+        "the machine did its part: it leaves as planned"
+    );
+    let mut last = None;
+    while let Ok(message) = analysis.try_recv() {
+        last = Some(message);
+    }
+    assert!(matches!(last, Some(PipelineMsg::Cut { .. })), "{last:?}");
 }
