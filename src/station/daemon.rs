@@ -91,19 +91,7 @@ impl Daemon {
                 self.replies.insert(id, reply);
                 Input::Request { id, request }
             }
-            DaemonMsg::Prepared { id, result } => Input::Prepared { id, result },
-            DaemonMsg::ScanEnded {
-                machine,
-                key,
-                result,
-            } => Input::ScanEnded {
-                machine,
-                key,
-                result,
-            },
-            DaemonMsg::Stored { job, key, result } => Input::Stored { job, key, result },
-            DaemonMsg::Cleared { machine, result } => Input::Cleared { machine, result },
-            DaemonMsg::Finished { job, result } => Input::Finished { job, result },
+            DaemonMsg::Input(input) => input,
         }
     }
 
@@ -139,8 +127,8 @@ impl Daemon {
                 let config = self.config.clone();
                 self.blocking(move || {
                     let result = prepare(&config, kind, &part, serial).map(Box::new);
-                    DaemonMsg::Prepared { id, result }
-                }, move |panic| DaemonMsg::Prepared {
+                    Input::Prepared { id, result }
+                }, move |panic| Input::Prepared {
                     id,
                     result: Err(super::job::JobError(format!(
                         "setting up the job failed inside the station ({panic}); this is a bug: report it with the daemon's log"
@@ -194,7 +182,9 @@ impl Daemon {
                 let to_self = self.to_self.clone();
                 tokio::spawn(async move {
                     let result = answer.await.unwrap_or_else(|_| Err(worker_gone(&machine)));
-                    let _ = to_self.send(DaemonMsg::Cleared { machine, result }).await;
+                    let _ = to_self
+                        .send(DaemonMsg::Input(Input::Cleared { machine, result }))
+                        .await;
                 });
             }
             Effect::SaveRecord { dir, record } => {
@@ -224,15 +214,15 @@ impl Daemon {
     /// so a job never waits for an answer that cannot come.
     fn blocking(
         &self,
-        work: impl FnOnce() -> DaemonMsg + Send + 'static,
-        on_panic: impl FnOnce(String) -> DaemonMsg + Send + 'static,
+        work: impl FnOnce() -> Input + Send + 'static,
+        on_panic: impl FnOnce(String) -> Input + Send + 'static,
     ) {
         let to_self = self.to_self.clone();
         tokio::spawn(async move {
             let message = tokio::task::spawn_blocking(work)
                 .await
                 .unwrap_or_else(|panic| on_panic(panic.to_string()));
-            let _ = to_self.send(message).await;
+            let _ = to_self.send(DaemonMsg::Input(message)).await;
         });
     }
 
@@ -286,8 +276,8 @@ impl Daemon {
                 }),
                 _ => finish::fit_reference(&plan, &dir, &path),
             };
-            DaemonMsg::Finished { job: id, result }
-        }, move |panic| DaemonMsg::Finished {
+            Input::Finished { job: id, result }
+        }, move |panic| Input::Finished {
             job: panic_id,
             result: Err::<Outcome, _>(format!(
                 "finishing the job failed inside the station ({panic}); its scans are on disk; this is a bug: report it with the daemon's log"

@@ -427,4 +427,4 @@ fn walk(from: usize, to: usize, len: usize, closed: bool) -> Vec<usize> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

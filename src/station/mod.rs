@@ -23,48 +23,20 @@ use tokio::sync::{broadcast, mpsc, oneshot};
 
 use crate::api::{Reply, Request};
 use crate::config::StationConfig;
-use crate::plan::ProfileKey;
-use worker::{ScanResult, WorkerError};
 
 pub use escape::{way_out, EscapeError, KnownPath};
 
 /// How many events a watcher may fall behind before it misses some: a whole inspection's points.
 const EVENT_BACKLOG: usize = 1 << 16;
 
-/// What the daemon's state task hears.
+/// What the daemon's state task hears: a request from the control socket, with the channel its reply goes back
+/// on, or one of the core's other inputs (from a worker, the recorder or the shell's own blocking work).
 pub enum DaemonMsg {
-    /// A request from the control socket.
     Request {
         request: Request,
         reply: oneshot::Sender<Reply>,
     },
-    /// A worker ended a scan order.
-    ScanEnded {
-        machine: String,
-        key: ProfileKey,
-        result: ScanResult,
-    },
-    /// The pipeline stored a profile's scan on disk (or could not).
-    Stored {
-        job: String,
-        key: ProfileKey,
-        result: Result<(), String>,
-    },
-    /// A worker cleared its machine (or could not).
-    Cleared {
-        machine: String,
-        result: Result<(), WorkerError>,
-    },
-    /// A job was set up off the decision task (or could not be).
-    Prepared {
-        id: core::RequestId,
-        result: Result<Box<job::Job>, job::JobError>,
-    },
-    /// A job's reference was fitted or its report written.
-    Finished {
-        job: String,
-        result: Result<finish::Outcome, String>,
-    },
+    Input(core::Input),
 }
 
 /// Runs the daemon until SIGINT or SIGTERM: binds the control socket, starts a worker per machine, reopens a job

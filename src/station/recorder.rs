@@ -13,6 +13,7 @@ use std::io;
 use tokio::sync::{broadcast, mpsc};
 
 use super::clock;
+use super::core::Input;
 use super::journal::{JobDir, PartialScan, ScanFile, ScanHeader};
 use super::DaemonMsg;
 use crate::analysis::stats::{DeviationStats, Verdict};
@@ -226,10 +227,10 @@ impl<D: Disk> Recorder<D> {
     }
 
     fn stored(&self, key: ProfileKey, result: Result<(), String>) {
-        let _ = self.daemon.blocking_send(DaemonMsg::Stored {
+        let _ = self.daemon.blocking_send(DaemonMsg::Input(Input::Stored {
             job: self.job.clone(),
             key,
             result,
-        });
+        }));
     }
 }

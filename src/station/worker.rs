@@ -16,6 +16,7 @@ use zeroset_drivers::machine::{
 use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
 
+use super::core::Input;
 use super::escape::{plan_escape, EscapeModel, KnownPath};
 use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
@@ -206,11 +207,11 @@ impl Worker {
                     self.alarms();
                     let result = self.scan(*motion, pipeline).await;
                     let result = result.map_err(|e| self.failed(e));
-                    let report = DaemonMsg::ScanEnded {
+                    let report = DaemonMsg::Input(Input::ScanEnded {
                         machine: self.name.clone(),
                         key,
                         result,
-                    };
+                    });
                     if daemon.send(report).await.is_err() {
                         return;
                     }

@@ -4,7 +4,7 @@
 use super::*;
 
 /// A circle of radius 20 mm in the plane x = 100, centre at z = 0, scanned from its top.
-fn circle(closed_points: usize) -> KnownPath {
+pub(crate) fn circle(closed_points: usize) -> KnownPath {
     let (surface, normals) = (0..closed_points)
         .map(|k| {
             let t = std::f64::consts::FRAC_PI_2

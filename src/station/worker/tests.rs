@@ -5,7 +5,7 @@
 use std::sync::{Arc, Mutex};
 
 use futures::stream;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc};
 use zeroset_drivers::machine::{
     CurveScan, Density, MockMachine, MockScanning, Nominal, ScanPoint, ScanStream, Scanning, Xyz,
@@ -39,21 +39,9 @@ fn safety() -> Safety {
     }
 }
 
-/// A circular profile of radius 20 mm in the plane x = 100, its top first (the entry).
+/// A circular profile of radius 20 mm in the plane x = 100, its top first (the entry), 72 points.
 fn circle() -> KnownPath {
-    let (surface, normals) = (0..72)
-        .map(|k| {
-            let t = std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * k as f64 / 72.0;
-            let n = Vector3::new(0.0, t.cos(), t.sin());
-            (Point3::new(100.0, 0.0, 0.0) + n * 20.0, n)
-        })
-        .unzip();
-    KnownPath {
-        surface,
-        normals,
-        closed: true,
-        entry: 0,
-    }
+    crate::station::escape::tests::circle(72)
 }
 
 fn curve_scan(path: &KnownPath) -> CurveScan {
@@ -195,12 +183,22 @@ fn point(z: f64) -> ScanPoint {
     }
 }
 
+async fn clear(worker: &WorkerHandle, escape: EscapeModel) -> Result<(), WorkerError> {
+    let (reply, answer) = tokio::sync::oneshot::channel();
+    worker
+        .orders
+        .send(Order::Clear { escape, reply })
+        .await
+        .unwrap();
+    answer.await.unwrap()
+}
+
 async fn scan_result(reports: &mut mpsc::Receiver<DaemonMsg>) -> ScanResult {
-    let DaemonMsg::ScanEnded {
+    let DaemonMsg::Input(Input::ScanEnded {
         machine,
         key,
         result,
-    } = reports.recv().await.unwrap()
+    }) = reports.recv().await.unwrap()
     else {
         panic!("expected the end of the scan");
     };
@@ -376,18 +374,12 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     // A daemon was killed with the ball under the circle (z = -21); the new daemon knows the cut scan's path.
     let position = Xyz::new(100.0, 0.0, -21.0);
     let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
-    let (reply, answer) = tokio::sync::oneshot::channel();
     let escape = EscapeModel {
         cut: Some((circle(), MARGIN_MM)),
         part: None,
         deviation_margin_mm: MARGIN_MM,
     };
-    worker
-        .orders
-        .send(Order::Clear { escape, reply })
-        .await
-        .unwrap();
-    answer.await.unwrap().expect("cleared");
+    clear(&worker, escape).await.expect("cleared");
     let moves = moves.lock().unwrap();
     assert!(
         close(moves.last().unwrap(), &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
@@ -408,16 +400,7 @@ async fn a_probe_near_the_part_with_no_known_way_out_is_not_moved_by_a_clear() {
         moves.clone(),
         Vec::new(),
     ));
-    let (reply, answer) = tokio::sync::oneshot::channel();
-    worker
-        .orders
-        .send(Order::Clear {
-            escape: EscapeModel::default(),
-            reply,
-        })
-        .await
-        .unwrap();
-    let error = answer.await.unwrap().unwrap_err();
+    let error = clear(&worker, EscapeModel::default()).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Refused);
     assert!(
         error.message.contains("jog the probe above z = 150 mm"),
@@ -461,16 +444,9 @@ async fn a_lost_link_is_opened_again_by_the_next_order_not_reused() {
         .unwrap();
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Transport, "{}", error.message);
-    let (reply, answer) = tokio::sync::oneshot::channel();
-    worker
-        .orders
-        .send(Order::Clear {
-            escape: EscapeModel::default(),
-            reply,
-        })
+    clear(&worker, EscapeModel::default())
         .await
-        .unwrap();
-    answer.await.unwrap().expect("cleared on a new link");
+        .expect("cleared on a new link");
     assert_eq!(
         *opened.lock().unwrap(),
         2,
@@ -507,16 +483,9 @@ async fn a_clear_on_a_session_the_machine_lost_starts_it_again() {
     machine.expect_end_session().returning(|| Ok(()));
     let (worker, _reports) = worker_on(machine);
     for _ in 0..2 {
-        let (reply, answer) = tokio::sync::oneshot::channel();
-        worker
-            .orders
-            .send(Order::Clear {
-                escape: EscapeModel::default(),
-                reply,
-            })
+        clear(&worker, EscapeModel::default())
             .await
-            .unwrap();
-        answer.await.unwrap().expect("cleared");
+            .expect("cleared");
     }
     // The first clear opens the session; the second finds it lost (0008) and opens it again.
     assert_eq!(*sessions.lock().unwrap(), 2);
