@@ -96,7 +96,9 @@ async fn machines_are_reached_through_their_links_which_go_when_the_simulator_st
         session_over(&link, machine).await;
     }
 
-    drop(sim.0.stdin.take());
+    // The end of its standard input does not stop the simulator; SIGTERM does, and removes the links.
+    let pid = Pid::from_raw(i32::try_from(sim.0.id()).unwrap());
+    kill(pid, Signal::SIGTERM).unwrap();
     let status = sim.0.wait().unwrap();
     assert!(status.success(), "{status}");
     for (machine, _) in &announced {
