@@ -101,12 +101,21 @@ fn bare_machine(
             None => Err(lost("GoTo")),
         });
     let mut scanning = MockScanning::new();
+    let in_plane = scan.clone();
     scanning
         .expect_scan_on_curve()
         .times(0..=1)
         .returning(move |_| {
             Ok(ScanStream::new(stream::iter(
                 scan.clone().into_iter().map(Ok),
+            )))
+        });
+    scanning
+        .expect_scan_in_plane()
+        .times(0..=1)
+        .returning(move |_| {
+            Ok(ScanStream::new(stream::iter(
+                in_plane.clone().into_iter().map(Ok),
             )))
         });
     let scanning: Arc<dyn Scanning> = Arc::new(scanning);
@@ -379,8 +388,18 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
         part: None,
         deviation_margin_mm: MARGIN_MM,
     };
+    // What the escape planner gives (and checks) for the same stop is what goes on the wire.
+    let planned = plan_escape(
+        Point3::new(position.x, position.y, position.z),
+        Some((&circle(), MARGIN_MM)),
+        1.0,
+        &safety(),
+        &escape,
+    )
+    .unwrap();
     clear(&worker, escape).await.expect("cleared");
     let moves = moves.lock().unwrap();
+    assert_eq!(*moves, planned.iter().map(xyz_of).collect::<Vec<_>>());
     assert!(
         close(moves.last().unwrap(), &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
         "{moves:?}"
@@ -528,4 +547,50 @@ async fn a_scan_with_a_hole_is_cut_not_counted_and_the_probe_still_leaves_as_pla
         last = Some(message);
     }
     assert!(matches!(last, Some(PipelineMsg::Cut { .. })), "{last:?}");
+}
+
+#[tokio::test]
+async fn a_teach_scan_sends_exactly_its_planned_motion() {
+    let xyz = |x, y, z| Xyz::new(x, y, z);
+    let scan = Scan::InPlane(zeroset_drivers::machine::InPlaneScan {
+        start: xyz(100.0, 0.0, 20.0),
+        start_normal: xyz(0.0, 0.0, 1.0),
+        plane_normal: xyz(1.0, 0.0, 0.0),
+        direction: xyz(100.0, 1.0, 20.0),
+        step: 2.0,
+        end: xyz(100.0, 0.0, 20.0),
+        stop_diameter: 3.0,
+        passes: 1,
+        end_normal: xyz(0.0, 0.0, 1.0),
+    });
+    let start = KnownPath {
+        surface: vec![Point3::new(100.0, 0.0, 20.0)],
+        normals: vec![nalgebra::Vector3::new(0.0, 0.0, 1.0)],
+        closed: false,
+        entry: 0,
+    };
+    let motion = ScanMotion::plan(KEY, "A r100".into(), scan, start, 5.0, &safety()).unwrap();
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
+    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), whole_circle()));
+    let (pipeline, _analysis) = mpsc::channel(128);
+    worker
+        .orders
+        .send(scan_order(motion.clone(), pipeline))
+        .await
+        .unwrap();
+    scan_result(&mut reports).await.expect("taught");
+    let planned: Vec<Xyz> = motion
+        .approach
+        .iter()
+        .chain(&motion.retract)
+        .map(xyz_of)
+        .collect();
+    assert_eq!(*moves.lock().unwrap(), planned);
+    // Straight down over the start by the planned ball and the teach margin, and back up the same way.
+    assert!(
+        close(&planned[1], &Xyz::new(100.0, 0.0, 26.5)),
+        "{planned:?}"
+    );
+    assert_eq!(planned.len(), 4);
 }
