@@ -140,13 +140,27 @@ const CLEAR_TO_CONTINUE: &str =
 impl Core {
     /// The station's machines, all idle, and a job a previous daemon left open (stopped until `zeroset clear`).
     pub fn new(station: String, machines: Vec<String>, reopened: Option<Job>) -> Core {
+        // A job left open means a daemon stopped while it ran: where its probes are is not known, so each machine
+        // starts locked out, and only `zeroset clear` (with the cut scans' ways out) lifts that.
+        let state = match &reopened {
+            Some(job) => MachineState::LockedOut {
+                fault: MachineFault {
+                    kind: FaultKind::Station,
+                    message: format!(
+                        "the daemon stopped while job {} ran; the probe may be near the part",
+                        job.info.id
+                    ),
+                },
+            },
+            None => MachineState::Idle,
+        };
         Core {
             station,
             slots: machines
                 .into_iter()
                 .map(|name| Slot {
                     name,
-                    state: MachineState::Idle,
+                    state: state.clone(),
                     at: None,
                 })
                 .collect(),
@@ -388,6 +402,14 @@ impl Core {
             }
             fault
         });
+        let fault = match fault {
+            // The abort was sent; it locks the machine out even when it came after the scan's last move.
+            None if aborting => Some(MachineFault {
+                kind: FaultKind::Aborted,
+                message: format!("machine {machine}: aborted by the operator"),
+            }),
+            fault => fault,
+        };
         if let Some(slot) = self.slot(machine) {
             slot.state = match &fault {
                 None => MachineState::Idle,
@@ -430,8 +452,21 @@ impl Core {
     /// A scan that ended well with a hole in it: the machine is ready; the profile is scanned again once, and a
     /// second hole stops the job.
     fn gap(&mut self, machine: &str, key: ProfileKey, error: &WorkerError) {
+        let aborting = self
+            .job
+            .as_ref()
+            .is_some_and(|j| j.phase == JobPhase::Aborting);
         if let Some(slot) = self.slot(machine) {
-            slot.state = MachineState::Idle;
+            slot.state = if aborting {
+                MachineState::LockedOut {
+                    fault: MachineFault {
+                        kind: FaultKind::Aborted,
+                        message: format!("machine {machine}: aborted by the operator"),
+                    },
+                }
+            } else {
+                MachineState::Idle
+            };
         }
         let Some(job) = self.job.as_mut() else {
             return;
@@ -618,6 +653,25 @@ impl Core {
     }
 
     fn abort(&mut self, id: RequestId) {
+        // A machine leaving the part after `zeroset clear` is stopped too: the operator saw it going wrong.
+        let clearing: Vec<String> = self
+            .slots
+            .iter()
+            .filter(|s| s.state == MachineState::Clearing)
+            .map(|s| s.name.clone())
+            .collect();
+        for machine in &clearing {
+            self.emit(Effect::Abort {
+                machine: machine.clone(),
+            });
+        }
+        if !clearing.is_empty() && self.job.as_ref().is_none_or(|j| j.is_over()) {
+            let message = format!(
+                "motion stopped on {}; run `zeroset clear` once the probe's way is free",
+                clearing.join(", ")
+            );
+            return self.reply(id, Reply::Done { message });
+        }
         if let Some(preparing) = self.preparing.as_mut() {
             preparing.aborted = true;
             let message = format!(

@@ -392,8 +392,20 @@ impl Worker {
         } else {
             self.open_session(&client).await?;
         }
+        // The way out first, with the tool the machine has on: changing it moves the head, so the station sets
+        // the machine up (`prepare`) only once the probe is at the clearance height.
         self.ball_radius = None;
-        let (client, radius) = self.prepare().await?;
+        let radius = client.tool_radius().await?;
+        if !(radius > 0.0 && radius <= self.safety.max_ball_radius_mm) {
+            return Err(WorkerError {
+                kind: FaultKind::Refused,
+                message: format!(
+                    "machine {}: its active tool has a ball radius of {radius} mm, outside (0, {}] mm, so no way out \
+                     can be checked; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
+                    self.name, self.safety.max_ball_radius_mm, self.safety.clearance_z_mm
+                ),
+            });
+        }
         let here = self.position(&client).await?;
         let path = self.path.as_ref().map(|(path, margin)| (path, *margin));
         let moves = plan_escape(here, path, radius, &self.safety, model)
@@ -408,6 +420,7 @@ impl Worker {
             client.go_to(xyz(&target)).await?;
         }
         self.path = None;
+        self.prepare().await?;
         Ok(())
     }
 
@@ -416,9 +429,12 @@ impl Worker {
         motion: ScanMotion,
         pipeline: mpsc::Sender<PipelineMsg>,
     ) -> ScanResult {
-        let (client, radius) = self.prepare().await?;
+        // Nothing moves, the set-up's tool change included, unless the probe is at the clearance height.
+        let client = self.connect()?;
+        self.open_session(&client).await?;
         self.require_clearance_height(&client, &format!("the approach to {}", motion.name))
             .await?;
+        let (client, radius) = self.prepare().await?;
         // From the descent on, the probe is near the part: a way out after a stop follows this scan's path.
         self.path = Some((motion.path.clone(), motion.margin_mm));
         for target in &motion.approach {

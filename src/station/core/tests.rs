@@ -562,3 +562,35 @@ fn a_profile_stored_after_its_machine_failed_on_the_way_out_is_not_scanned_again
     let next = scanned(&effects).expect("the job continues");
     assert_ne!(next, key, "the stored profile is not scanned again");
 }
+
+#[test]
+fn after_a_restart_with_a_job_open_the_machines_are_locked_out_until_clear() {
+    let mut bench = Bench::new();
+    let job = bench.teach_job();
+    bench.core = Core::new("test station".into(), vec![MACHINE.into()], Some(*job));
+    assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
+    // Aborting the reopened job does not free the machine: a new job still waits for `zeroset clear`.
+    bench.request(Request::Abort);
+    let (_, effects) = bench.request(Request::Teach {
+        part: "propeller".into(),
+    });
+    assert!(
+        matches!(reply_of(&effects), Some(Reply::Error { message }) if message.contains("zeroset clear"))
+    );
+}
+
+#[test]
+fn abort_stops_a_machine_that_is_leaving_the_part_after_a_clear() {
+    let mut bench = Bench::new();
+    let key = scanned(&bench.start_teach()).unwrap();
+    bench.scan_ended(key, Err(estop()));
+    bench.request(Request::Clear);
+    assert_eq!(bench.machine(), MachineState::Clearing);
+    let (_, effects) = bench.request(Request::Abort);
+    assert!(effects
+        .iter()
+        .any(|e| matches!(e, Effect::Abort { machine } if machine == MACHINE)));
+    assert!(!effects
+        .iter()
+        .any(|e| matches!(e, Effect::Clear { .. } | Effect::Scan { .. })));
+}
