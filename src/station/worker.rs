@@ -3,6 +3,7 @@
 //! pipeline as they arrive, and the planned lift-off and way out. Anything that goes wrong ends the order with a
 //! typed error naming the machine, sends nothing more, and leaves the machine alone until the operator clears it.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -54,6 +55,9 @@ pub struct WorkerHandle {
     pub orders: mpsc::Sender<Order>,
     /// The machine's link, to abort a scan from outside the worker.
     link: Arc<Mutex<Option<Link>>>,
+    /// Set by an abort, cleared by the next clear: the worker sends no motion while it is set, so an abort that
+    /// finds no link yet (a fresh daemon's first order) still stops the order.
+    aborted: Arc<AtomicBool>,
 }
 
 /// A machine as the worker drives it: the I++ client on a line, or a mock in the tests.
@@ -66,6 +70,7 @@ impl WorkerHandle {
     /// Stops all motion now (I++ `AbortE` jumps the machine's queue); the running order ends with an error and
     /// the machine stays locked out until `zeroset clear`.
     pub async fn abort(&self) {
+        self.aborted.store(true, Ordering::SeqCst);
         let client = self.link.lock().expect("not poisoned").clone();
         if let Some(client) = client {
             if let Err(error) = client.abort().await {
@@ -96,10 +101,12 @@ pub fn spawn_on(
 ) -> WorkerHandle {
     let (orders, inbox) = mpsc::channel(4);
     let link = Arc::new(Mutex::new(None));
+    let aborted = Arc::new(AtomicBool::new(false));
     let handle = WorkerHandle {
         name: name.clone(),
         orders,
         link: link.clone(),
+        aborted: aborted.clone(),
     };
     let worker = Worker {
         name,
@@ -107,6 +114,7 @@ pub fn spawn_on(
         probe,
         safety,
         link,
+        aborted,
         alarms: None,
         session: false,
         ball_radius: None,
@@ -148,6 +156,7 @@ struct Worker {
     probe: ProbeSettings,
     safety: Safety,
     link: Arc<Mutex<Option<Link>>>,
+    aborted: Arc<AtomicBool>,
     /// What the machine reported outside the commands (an emergency stop, an alarm) since the link opened.
     alarms: Option<broadcast::Receiver<Event>>,
     /// Whether this worker holds an I++ session on the current link.
@@ -217,6 +226,8 @@ impl Worker {
                     }
                 }
                 Order::Clear { escape, reply } => {
+                    // An operator's clear lifts an abort, as it lifts every lockout.
+                    self.aborted.store(false, Ordering::SeqCst);
                     if let (None, Some(cut)) = (&self.path, escape.cut.clone()) {
                         self.path = Some(cut);
                     }
@@ -438,6 +449,7 @@ impl Worker {
         // From the descent on, the probe is near the part: a way out after a stop follows this scan's path.
         self.path = Some((motion.path.clone(), motion.margin_mm));
         for target in &motion.approach {
+            self.not_aborted()?;
             client.go_to(xyz(target)).await?;
         }
         let scanning = client.scanning().ok_or_else(|| WorkerError {
@@ -458,6 +470,7 @@ impl Worker {
         if pipeline.send(start).await.is_err() {
             return Err(self.pipeline_gone());
         }
+        self.not_aborted()?;
         let started = match &motion.scan {
             Scan::InPlane(plan) => scanning.scan_in_plane(plan.clone()).await,
             Scan::Curve(plan) => scanning.scan_on_curve(plan.clone()).await,
@@ -514,6 +527,7 @@ impl Worker {
             });
         }
         for target in &motion.retract {
+            self.not_aborted()?;
             client.go_to(xyz(target)).await?;
         }
         self.path = None;
@@ -564,6 +578,20 @@ impl Worker {
             }
         }
         Ok(centres)
+    }
+
+    /// Refuses the next motion command after an operator's abort, until a clear.
+    fn not_aborted(&self) -> Result<(), WorkerError> {
+        if self.aborted.load(Ordering::SeqCst) {
+            return Err(WorkerError {
+                kind: FaultKind::Aborted,
+                message: format!(
+                    "machine {}: aborted by the operator; nothing more was sent",
+                    self.name
+                ),
+            });
+        }
+        Ok(())
     }
 
     fn pipeline_gone(&self) -> WorkerError {

@@ -594,3 +594,31 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
     );
     assert_eq!(planned.len(), 4);
 }
+
+#[tokio::test]
+async fn an_abort_before_the_first_connection_still_stops_the_order_until_a_clear() {
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0); 3];
+    let mut machine = machine(positions, moves.clone(), whole_circle());
+    machine.expect_clear_all_errors().returning(|| Ok(()));
+    let (worker, mut reports) = worker_on(machine);
+    // No link is open yet: the AbortE cannot be sent, but the order that follows sends no motion.
+    worker.abort().await;
+    let (pipeline, _analysis) = mpsc::channel(128);
+    worker
+        .orders
+        .send(scan_order(motion(), pipeline))
+        .await
+        .unwrap();
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Aborted, "{}", error.message);
+    assert!(
+        moves.lock().unwrap().is_empty(),
+        "{:?}",
+        moves.lock().unwrap()
+    );
+    // The operator's clear lifts it (at the clearance height: nothing to move).
+    clear(&worker, EscapeModel::default())
+        .await
+        .expect("cleared");
+}
