@@ -155,11 +155,12 @@ fn motion() -> ScanMotion {
     .expect("a plan")
 }
 
-fn scan_order(motion: ScanMotion, pipeline: mpsc::Sender<PipelineMsg>) -> Order {
-    Order::Scan {
+async fn send_scan(worker: &WorkerHandle, motion: ScanMotion, pipeline: mpsc::Sender<PipelineMsg>) {
+    let order = Order::Scan {
         motion: Box::new(motion),
         pipeline,
-    }
+    };
+    worker.orders.send(order).await.unwrap();
 }
 
 fn close(a: &Xyz, b: &Xyz) -> bool {
@@ -224,11 +225,7 @@ async fn a_scan_sends_exactly_its_planned_motion_which_is_what_the_clearance_che
     let scanned = whole_circle();
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned.clone()));
     let (pipeline, mut analysis) = mpsc::channel(128);
-    worker
-        .orders
-        .send(scan_order(motion.clone(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion.clone(), pipeline).await;
     scan_result(&mut reports).await.expect("scanned");
 
     let sent = moves.lock().unwrap().clone();
@@ -311,11 +308,7 @@ async fn below_the_clearance_height_before_a_scan_nothing_moves() {
     let positions = vec![Xyz::new(100.0, -25.0, 10.0)];
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), Vec::new()));
     let (pipeline, _analysis) = mpsc::channel(16);
-    worker
-        .orders
-        .send(scan_order(motion(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion(), pipeline).await;
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Refused);
     assert!(
@@ -338,11 +331,7 @@ async fn a_scan_that_ends_away_from_its_planned_end_is_not_retracted_by_the_plan
     let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, -21.0)];
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), vec![point(21.0)]));
     let (pipeline, _analysis) = mpsc::channel(16);
-    worker
-        .orders
-        .send(scan_order(motion.clone(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion.clone(), pipeline).await;
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Refused, "{}", error.message);
     assert!(
@@ -456,11 +445,7 @@ async fn a_lost_link_is_opened_again_by_the_next_order_not_reused() {
     };
     let (worker, mut reports) = worker_with(connector);
     let (pipeline, _analysis) = mpsc::channel(16);
-    worker
-        .orders
-        .send(scan_order(motion(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion(), pipeline).await;
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Transport, "{}", error.message);
     clear(&worker, EscapeModel::default())
@@ -519,11 +504,7 @@ async fn a_scan_with_a_hole_is_cut_not_counted_and_the_probe_still_leaves_as_pla
     scanned.drain(20..30);
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), scanned));
     let (pipeline, mut analysis) = mpsc::channel(128);
-    worker
-        .orders
-        .send(scan_order(motion.clone(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion.clone(), pipeline).await;
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Gap, "{}", error.message);
     assert!(
@@ -574,11 +555,7 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
     let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), whole_circle()));
     let (pipeline, _analysis) = mpsc::channel(128);
-    worker
-        .orders
-        .send(scan_order(motion.clone(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion.clone(), pipeline).await;
     scan_result(&mut reports).await.expect("taught");
     let planned: Vec<Xyz> = motion
         .approach
@@ -605,11 +582,7 @@ async fn an_abort_before_the_first_connection_still_stops_the_order_until_a_clea
     // No link is open yet: the AbortE cannot be sent, but the order that follows sends no motion.
     worker.abort().await;
     let (pipeline, _analysis) = mpsc::channel(128);
-    worker
-        .orders
-        .send(scan_order(motion(), pipeline))
-        .await
-        .unwrap();
+    send_scan(&worker, motion(), pipeline).await;
     let error = scan_result(&mut reports).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Aborted, "{}", error.message);
     assert!(
