@@ -24,8 +24,6 @@ use tokio::sync::{broadcast, mpsc, oneshot};
 use crate::api::{Reply, Request};
 use crate::config::StationConfig;
 
-pub use escape::{way_out, EscapeError, KnownPath};
-
 /// How many events a watcher may fall behind before it misses some: a whole inspection's points.
 const EVENT_BACKLOG: usize = 1 << 16;
 
