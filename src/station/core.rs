@@ -8,6 +8,8 @@
 //! operator's `zeroset clear`; an abort sends AbortE to the scanning machines and nothing else, never a clear or
 //! a move; a job does not start while any machine is locked out.
 
+use std::sync::Arc;
+
 use nalgebra::Point3;
 
 use super::escape::{EscapeModel, KnownPath};
@@ -21,6 +23,7 @@ use crate::api::{
     Event, FaultKind, JobKind, JobPhase, JobStatus, MachineFault, MachineState, MachineStatus,
     PreparingJob, Reply, Request, StationStatus,
 };
+use crate::geometry::sweep::mesh::MeshPart;
 use crate::plan::ProfileKey;
 
 /// Which request a reply answers; the shell keeps the reply channels.
@@ -83,6 +86,8 @@ pub enum Effect {
     Scan {
         machine: String,
         motion: Box<ScanMotion>,
+        /// The taught part model, against which the lift-off from where the scan really ended is checked.
+        part: Option<Arc<MeshPart>>,
     },
     /// AbortE on `machine`: stop its motion now.
     Abort {
@@ -361,6 +366,7 @@ impl Core {
             orders.push((slot.name.clone(), Box::new(job.motions[&key].clone()), scan));
         }
         let id = job.info.id.clone();
+        let part = job.part_model.clone();
         for (machine, motion, scan) in orders {
             self.publish(Event::ScanStarted {
                 job: id.clone(),
@@ -368,7 +374,11 @@ impl Core {
                 scan,
                 at_unix_ms: super::clock::unix_ms(),
             });
-            self.emit(Effect::Scan { machine, motion });
+            self.emit(Effect::Scan {
+                machine,
+                motion,
+                part: part.clone(),
+            });
         }
     }
 

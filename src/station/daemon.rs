@@ -137,7 +137,11 @@ impl Daemon {
             }
             Effect::StartPipeline => self.start_pipeline(),
             Effect::StopPipeline => self.pipeline = None,
-            Effect::Scan { machine, motion } => {
+            Effect::Scan {
+                machine,
+                motion,
+                part,
+            } => {
                 let key = motion.key;
                 let Some(pipeline) = self.pipeline.clone() else {
                     return Some(station_fault(
@@ -149,7 +153,11 @@ impl Daemon {
                 let given = self.workers.get(&machine).is_some_and(|worker| {
                     worker
                         .orders
-                        .try_send(Order::Scan { motion, pipeline })
+                        .try_send(Order::Scan {
+                            motion,
+                            part,
+                            pipeline,
+                        })
                         .is_ok()
                 });
                 if !given {

@@ -71,6 +71,9 @@ const ON_PATH_TOLERANCE_MM: f64 = 3.0;
 /// How far from the vertical over a scan's entry the ball may be and still be on its descent (or its final rise):
 /// the difference between the planned ball and the real one, mm.
 const ON_DESCENT_TOLERANCE_MM: f64 = 0.5;
+/// How much nearer than it started the ball may come on a way out's first leg, mm: the rounding and noise of the
+/// position the machine reports, so that a lift-off straight off the surface is not refused for a micron.
+const FIRST_LEG_SLACK_MM: f64 = 0.005;
 
 impl KnownPath {
     /// The nominal curve of a curve scan, entered at its first nominal (the plan puts the entry there).
@@ -246,6 +249,28 @@ pub fn plan_escape(
         Ok(moves) => moves,
         Err(error) => return straight_up_if_free(position, ball_radius, safety, model, error),
     };
+    check_way_out(
+        position,
+        &moves,
+        known,
+        ball_radius,
+        safety,
+        model.part.as_deref(),
+    )?;
+    Ok(moves)
+}
+
+/// Checks the moves from `position` before anything moves: once off the surface the ball never comes nearer the
+/// known surface, nor the taught part model, than the move margin; on the first leg, which may start in contact,
+/// it never comes nearer than it started (less the slack of a reported position).
+pub fn check_way_out(
+    position: Point3<f64>,
+    moves: &[Point3<f64>],
+    known: Option<&KnownPath>,
+    ball_radius: f64,
+    safety: &Safety,
+    part: Option<&MeshPart>,
+) -> Result<(), EscapeError> {
     let wanted = safety.move_margin_mm;
     let mut from = position;
     for (leg, &to) in moves.iter().enumerate() {
@@ -255,9 +280,10 @@ pub fn plan_escape(
             let least = surface_distance(path, &from, &to) - ball_radius;
             against.push(("the known surface", start, least));
         }
-        if let Some(part) = model.part.as_deref() {
+        if let Some(part) = part {
             let start = part.distance(&from) - ball_radius;
-            let least = ball_clearance(part, &from, &to, ball_radius, wanted);
+            let needed = first_leg_floor(leg, start - part.chord_tolerance_mm(), wanted);
+            let least = ball_clearance(part, &from, &to, ball_radius, needed);
             // The mesh lies within its chord tolerance of the model: a lift-off may seem to dip by as much.
             against.push((
                 "the taught part model",
@@ -266,12 +292,7 @@ pub fn plan_escape(
             ));
         }
         for (what, start, least) in against {
-            let needed = if leg == 0 {
-                start.min(wanted) - 1e-9
-            } else {
-                wanted
-            };
-            if least < needed {
+            if least < first_leg_floor(leg, start, wanted) {
                 return Err(EscapeError::NotClear {
                     position,
                     leg,
@@ -283,7 +304,17 @@ pub fn plan_escape(
         }
         from = to;
     }
-    Ok(moves)
+    Ok(())
+}
+
+/// The least clearance a leg must keep, mm: the move margin, or on the first leg, which may start in contact
+/// (or, against the nominal model, inside it by the part's deviation), what it started with.
+fn first_leg_floor(leg: usize, start: f64, wanted: f64) -> f64 {
+    if leg == 0 {
+        start.min(wanted) - FIRST_LEG_SLACK_MM
+    } else {
+        wanted
+    }
 }
 
 /// Off every known path, the one way out that can still be proven: straight up, if the taught model says the
@@ -310,14 +341,15 @@ fn straight_up_if_free(
 }
 
 /// The least clearance (mm) of a ball moved straight from `a` to `b` against `part`, by conservative advancement
-/// (the distance is 1-Lipschitz along the centre's path, so a step no longer than the gap cannot pass through the
-/// surface); once below `margin` it goes on towards contact to find the least.
+/// (the distance is 1-Lipschitz along the centre's path, so a step no longer than the gap above `needed` cannot
+/// pass below it). `needed` may be negative (a leg starting inside the nominal model), and the whole leg is still
+/// checked. Once below `needed` it goes on towards contact to find how near the ball comes.
 fn ball_clearance(
     part: &MeshPart,
     a: &Point3<f64>,
     b: &Point3<f64>,
     radius: f64,
-    margin: f64,
+    needed: f64,
 ) -> f64 {
     const RESOLUTION_MM: f64 = 1e-4;
     let length = (b - a).norm();
@@ -326,10 +358,11 @@ fn ball_clearance(
     loop {
         let gap = part.distance(&(a + (b - a) * t)) - radius;
         least = least.min(gap);
-        if gap <= 0.0 || t >= 1.0 || length == 0.0 {
+        let failed = least < needed;
+        if t >= 1.0 || length == 0.0 || (failed && (gap <= 0.0 || needed <= 0.0)) {
             return least;
         }
-        let target = if least >= margin { margin } else { 0.0 };
+        let target = if failed { 0.0 } else { needed };
         t = (t + (gap - target).max(RESOLUTION_MM) / length).min(1.0);
     }
 }

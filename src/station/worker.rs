@@ -18,7 +18,7 @@ use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
 
 use super::core::Input;
-use super::escape::{plan_escape, EscapeModel, KnownPath};
+use super::escape::{check_way_out, plan_escape, EscapeModel, KnownPath};
 use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
 use super::pipeline::PipelineMsg;
@@ -26,6 +26,7 @@ use super::DaemonMsg;
 use crate::analysis::RawPoint;
 use crate::api::{FaultKind, MachineFault};
 use crate::config::{MachineEntry, ProbeSettings, Safety};
+use crate::geometry::sweep::mesh::MeshPart;
 
 /// I++ error 0008, "Protocol error": what a controller answers to StartSession while it holds a session, and to
 /// other commands on a session it no longer holds.
@@ -38,6 +39,9 @@ pub enum Order {
     /// Scan one profile by its planned motion, every point to the job's pipeline.
     Scan {
         motion: Box<ScanMotion>,
+        /// The taught part model (none when teaching): the lift-off from where the scan really ended is checked
+        /// against it, and against the scan's known path, before it is sent.
+        part: Option<Arc<MeshPart>>,
         pipeline: mpsc::Sender<PipelineMsg>,
     },
     /// Clear the machine's errors (reconnecting a lost link, re-opening its session) and take the probe clear of
@@ -210,11 +214,15 @@ impl Worker {
     async fn run(mut self, mut inbox: mpsc::Receiver<Order>, daemon: mpsc::Sender<DaemonMsg>) {
         while let Some(order) = inbox.recv().await {
             match order {
-                Order::Scan { motion, pipeline } => {
+                Order::Scan {
+                    motion,
+                    part,
+                    pipeline,
+                } => {
                     let key = motion.key;
                     // Alarms from before this order were reported with the order they stopped.
                     self.alarms();
-                    let result = self.scan(*motion, pipeline).await;
+                    let result = self.scan(*motion, part.as_deref(), pipeline).await;
                     let result = result.map_err(|e| self.failed(e));
                     let report = DaemonMsg::Input(Input::ScanEnded {
                         machine: self.name.clone(),
@@ -438,6 +446,7 @@ impl Worker {
     async fn scan(
         &mut self,
         motion: ScanMotion,
+        part: Option<&MeshPart>,
         pipeline: mpsc::Sender<PipelineMsg>,
     ) -> ScanResult {
         // Nothing moves, the set-up's tool change included, unless the probe is at the clearance height.
@@ -493,7 +502,7 @@ impl Worker {
             return Err(self.pipeline_gone());
         }
         streamed?;
-        self.retract(&client, &motion).await?;
+        self.retract(&client, &motion, radius, part).await?;
         match gap {
             None => Ok(()),
             Some(gap) => Err(WorkerError {
@@ -506,8 +515,16 @@ impl Worker {
         }
     }
 
-    /// The planned lift-off and way out, sent only if the scan ended where the plan has it end.
-    async fn retract(&mut self, client: &Link, motion: &ScanMotion) -> ScanResult {
+    /// The planned lift-off and way out, sent only if the scan ended where the plan has it end and the lift-off
+    /// from where it really ended (the one leg the set-up's sweep could not see) keeps clear of the scan's known
+    /// surface (for a teach, the points just measured) and of the taught part model.
+    async fn retract(
+        &mut self,
+        client: &Link,
+        motion: &ScanMotion,
+        radius: f64,
+        part: Option<&MeshPart>,
+    ) -> ScanResult {
         let here = self.position(client).await?;
         let off = (here - motion.end).norm();
         if off > motion.end_tolerance_mm {
@@ -526,6 +543,16 @@ impl Worker {
                 ),
             });
         }
+        let known = self.path.as_ref().map(|(path, _)| path);
+        check_way_out(here, &motion.retract, known, radius, &self.safety, part).map_err(|e| {
+            WorkerError {
+                kind: FaultKind::Refused,
+                message: format!(
+                    "machine {}: after the scan of {}, {e}: nothing was moved; run `zeroset clear`",
+                    self.name, motion.name
+                ),
+            }
+        })?;
         for target in &motion.retract {
             self.not_aborted()?;
             client.go_to(xyz(target)).await?;

@@ -158,7 +158,9 @@ fn a_job_is_set_up_off_the_decision_task_and_status_answers_meanwhile() {
     let motion = effects
         .iter()
         .find_map(|e| match e {
-            Effect::Scan { motion, machine } if machine == MACHINE => Some(motion),
+            Effect::Scan {
+                motion, machine, ..
+            } if machine == MACHINE => Some(motion),
             _ => None,
         })
         .unwrap();

@@ -156,8 +156,19 @@ fn motion() -> ScanMotion {
 }
 
 async fn send_scan(worker: &WorkerHandle, motion: ScanMotion, pipeline: mpsc::Sender<PipelineMsg>) {
+    send_scan_by(worker, motion, None, pipeline).await;
+}
+
+/// Sends a scan order with the taught part model `part`.
+async fn send_scan_by(
+    worker: &WorkerHandle,
+    motion: ScanMotion,
+    part: Option<Arc<MeshPart>>,
+    pipeline: mpsc::Sender<PipelineMsg>,
+) {
     let order = Order::Scan {
         motion: Box::new(motion),
+        part,
         pipeline,
     };
     worker.orders.send(order).await.unwrap();
@@ -340,6 +351,93 @@ async fn a_scan_that_ends_away_from_its_planned_end_is_not_retracted_by_the_plan
         error.message
     );
     let sent = moves.lock().unwrap().clone();
+    assert_eq!(sent, motion.approach.iter().map(xyz_of).collect::<Vec<_>>());
+}
+
+/// A closed box, outward triangles, mm.
+fn block(min: [f64; 3], max: [f64; 3]) -> MeshPart {
+    let vertices: Vec<Point3<f64>> = (0..8)
+        .map(|i| {
+            let pick = |axis: usize| {
+                if i >> axis & 1 == 1 {
+                    max[axis]
+                } else {
+                    min[axis]
+                }
+            };
+            Point3::new(pick(0), pick(1), pick(2))
+        })
+        .collect();
+    // Faces x-, x+, y-, y+, z-, z+ as quads of the corner indices (bit 0: x, bit 1: y, bit 2: z), outward.
+    let quads = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
+        .collect();
+    let part = MeshPart::new(vertices, triangles, 0.0).unwrap();
+    assert!(part.is_signed(), "the block is closed and outward");
+    part
+}
+
+/// After a scan that ended within its tolerance of the planned end, the worker sends what was sent before it
+/// and the verdict; the planned retract is `motion.retract`.
+async fn retract_after_an_end_at(
+    end: Xyz,
+    part: Option<Arc<MeshPart>>,
+) -> (ScanMotion, Vec<Xyz>, WorkerError) {
+    let motion = motion();
+    assert!((Point3::new(end.x, end.y, end.z) - motion.end).norm() < motion.end_tolerance_mm);
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), end];
+    let (worker, mut reports) = worker_on(machine(positions, moves.clone(), whole_circle()));
+    let (pipeline, _analysis) = mpsc::channel(128);
+    send_scan_by(&worker, motion.clone(), part, pipeline).await;
+    let error = scan_result(&mut reports).await.unwrap_err();
+    let sent = moves.lock().unwrap().clone();
+    (motion, sent, error)
+}
+
+#[tokio::test]
+async fn a_lift_off_from_where_the_scan_really_ended_is_checked_against_the_part_model() {
+    // A block beside the entry, 2 mm from the planned lift-off (the sweep's), which keeps the 1 mm ball 1 mm off
+    // it; the scan really ended 3 mm along x and 3 mm up, 0.5 mm over the block, and from there the straight
+    // lift-off to the entry's offset grazes its edge.
+    let part = Arc::new(block([102.0, -5.0, 0.0], [110.0, 5.0, 23.0]));
+    let (motion, sent, error) =
+        retract_after_an_end_at(Xyz::new(103.0, 0.0, 24.5), Some(part)).await;
+    assert_eq!(error.kind, FaultKind::Refused, "{}", error.message);
+    assert!(
+        error.message.contains("the taught part model")
+            && error.message.contains("instance B, profile r300")
+            && error.message.contains("zeroset clear"),
+        "{}",
+        error.message
+    );
+    assert_eq!(
+        sent,
+        motion.approach.iter().map(xyz_of).collect::<Vec<_>>(),
+        "nothing moves after the scan"
+    );
+}
+
+#[tokio::test]
+async fn a_lift_off_through_the_known_surface_is_refused() {
+    // The machine reports the ball 3 mm inside the circle's top (4.5 mm from the planned end, within tolerance):
+    // the lift-off to the entry's offset would pass through the surface the scan just followed.
+    let (motion, sent, error) = retract_after_an_end_at(Xyz::new(100.0, 0.0, 17.0), None).await;
+    assert_eq!(error.kind, FaultKind::Refused, "{}", error.message);
+    assert!(
+        error.message.contains("the known surface"),
+        "{}",
+        error.message
+    );
     assert_eq!(sent, motion.approach.iter().map(xyz_of).collect::<Vec<_>>());
 }
 
