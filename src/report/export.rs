@@ -7,7 +7,7 @@ pub fn history_csv(history: &[ProfileRecord]) -> String {
     let mut writer = csv::Writer::from_writer(Vec::new());
     let header = [
         "serial", "finished", "instance", "profile", "points", "mean_mm", "rms_mm", "min_mm",
-        "max_mm", "lower_mm", "upper_mm", "passed",
+        "max_mm", "lower_mm", "upper_mm", "passed", "rescans",
     ];
     writer.write_record(header).expect("writing to memory");
     for r in history {
@@ -25,6 +25,7 @@ pub fn history_csv(history: &[ProfileRecord]) -> String {
                 r.lower_mm.to_string(),
                 r.upper_mm.to_string(),
                 r.passed.to_string(),
+                r.rescans.to_string(),
             ])
             .expect("writing to memory");
     }
@@ -48,6 +49,7 @@ mod tests {
             min_mm: -0.6775,
             max_mm: 0.6879,
             passed: false,
+            rescans: 1,
             lower_mm: -0.1,
             upper_mm: 0.1,
         };
@@ -57,7 +59,7 @@ mod tests {
         assert!(lines[0].starts_with("serial,finished,instance,profile,points,mean_mm"));
         assert_eq!(
             lines[1],
-            "SN-1,2026-11-23T10:00:00Z,B,r300,357,0.11481,0.6068,-0.6775,0.6879,-0.1,0.1,false"
+            "SN-1,2026-11-23T10:00:00Z,B,r300,357,0.11481,0.6068,-0.6775,0.6879,-0.1,0.1,false,1"
         );
     }
 }

@@ -16,7 +16,8 @@ use crate::analysis::stats::{DeviationStats, Verdict};
 pub const STORE_FILE: &str = "history.sqlite";
 
 /// Migration k brings the schema from version k to k + 1.
-const MIGRATIONS: &[&str] = &[r#"
+const MIGRATIONS: &[&str] = &[
+    r#"
     CREATE TABLE parts (
         serial      TEXT PRIMARY KEY,
         part_type   TEXT NOT NULL,
@@ -63,7 +64,18 @@ const MIGRATIONS: &[&str] = &[r#"
     );
     CREATE INDEX inspections_by_serial ON inspections(serial, finished);
     CREATE INDEX inspections_by_type ON inspections(part_type, finished);
-"#];
+"#,
+    r#"
+    CREATE TABLE rescans (
+        inspection  INTEGER NOT NULL REFERENCES inspections(id) ON DELETE CASCADE,
+        instance    TEXT NOT NULL,
+        profile     TEXT NOT NULL,
+        reason      TEXT NOT NULL,
+        at          TEXT NOT NULL
+    );
+    CREATE INDEX rescans_by_profile ON rescans(inspection, instance, profile);
+"#,
+];
 
 /// The history database.
 pub struct Store {
@@ -92,6 +104,8 @@ pub struct ProfileRecord {
     pub min_mm: f64,
     pub max_mm: f64,
     pub passed: bool,
+    /// How many times the profile was scanned again because a scan of it came back with a gap.
+    pub rescans: usize,
     /// The inspection's tolerance band, mm.
     pub lower_mm: f64,
     pub upper_mm: f64,
@@ -171,7 +185,9 @@ impl Store {
             .connection
             .prepare(
                 "SELECT i.serial, i.finished, p.instance, p.profile, p.points, p.mean_mm, p.rms_mm, p.min_mm,
-                        p.max_mm, p.passed, i.lower_mm, i.upper_mm
+                        p.max_mm, p.passed, i.lower_mm, i.upper_mm,
+                        (SELECT COUNT(*) FROM rescans r
+                         WHERE r.inspection = p.inspection AND r.instance = p.instance AND r.profile = p.profile)
                  FROM profile_stats p JOIN inspections i ON i.id = p.inspection
                  WHERE i.id IN (SELECT id FROM inspections WHERE part_type = ?1
                                 ORDER BY finished DESC, id DESC LIMIT ?2)
@@ -193,6 +209,7 @@ impl Store {
                     passed: row.get(9)?,
                     lower_mm: row.get(10)?,
                     upper_mm: row.get(11)?,
+                    rescans: row.get::<_, i64>(12)? as usize,
                 })
             })
             .map_err(|e| self.error(e))?;
@@ -222,6 +239,12 @@ fn enter(tx: &Transaction, report: &PartReport, report_dir: &Path) -> rusqlite::
         ],
     )?;
     let inspection = tx.last_insert_rowid();
+    for rescan in &report.rescans {
+        tx.execute(
+            "INSERT INTO rescans (inspection, instance, profile, reason, at) VALUES (?1, ?2, ?3, ?4, ?5)",
+            params![inspection, rescan.instance, rescan.profile, rescan.reason, rescan.at],
+        )?;
+    }
     for instance in &report.instances {
         let s = &instance.stats;
         tx.execute(

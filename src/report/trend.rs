@@ -110,6 +110,7 @@ mod tests {
             min_mm: mean_mm,
             max_mm: mean_mm,
             passed: true,
+            rescans: 0,
             lower_mm: -0.1,
             upper_mm: 0.1,
         }

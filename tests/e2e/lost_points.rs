@@ -57,6 +57,14 @@ fn a_scan_that_lost_a_line_of_points_is_scanned_again_to_its_full_count() {
             "{serial}: every rescan in the report"
         );
         eprintln!("{serial}: line lost after point {at}: {rescans} rescan(s)");
+        // The history keeps the rescans too, against the profile rescanned.
+        let csv = station.cli_ok(&["report", "--export", "csv"]);
+        let rescans_in_history: usize = csv
+            .lines()
+            .filter(|line| line.starts_with(serial))
+            .map(|line| line.rsplit(',').next().unwrap().parse::<usize>().unwrap())
+            .sum();
+        assert_eq!(rescans_in_history, rescans, "{serial}: {csv}");
     }
 }
 

@@ -32,6 +32,36 @@ fn an_inspection_is_entered_whole_and_read_back_per_profile() {
 }
 
 #[test]
+fn every_rescan_of_an_inspection_is_kept_with_its_profile() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut store = open(&dir);
+    let mut report = sample_report();
+    let (instance, profile) = (
+        report.instances[1].name.clone(),
+        report.instances[1].profiles[1].name.clone(),
+    );
+    report.rescans = vec![crate::report::Rescan {
+        instance: instance.clone(),
+        profile: profile.clone(),
+        reason: "a gap of 4.10 mm after point 120".into(),
+        at: "2025-03-04T10:11:12Z".into(),
+    }];
+    store.record(&report, Path::new("/r/1")).unwrap();
+    // Entered again (a job finished twice), the rescan still counts once.
+    store.record(&report, Path::new("/r/1")).unwrap();
+    let history = store.profile_history("propeller-3", 10).unwrap();
+    for record in &history {
+        let expected = usize::from(record.instance == instance && record.profile == profile);
+        assert_eq!(record.rescans, expected, "{record:?}");
+    }
+    let reason: String = store
+        .connection
+        .query_row("SELECT reason FROM rescans", [], |row| row.get(0))
+        .unwrap();
+    assert_eq!(reason, "a gap of 4.10 mm after point 120");
+}
+
+#[test]
 fn the_same_job_entered_twice_counts_once_and_history_keeps_the_newest() {
     let dir = tempfile::tempdir().unwrap();
     let mut store = open(&dir);
