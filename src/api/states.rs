@@ -39,6 +39,8 @@ pub enum FaultKind {
     Device { severity: u8, code: u16 },
     /// The link failed: timeout, garbled or missing replies, a closed line.
     Transport,
+    /// The machine's port cannot be opened: missing, or held by another program.
+    PortMissing,
     /// The driver refused to send motion while the machine was in an error state.
     LockedOut,
     /// The operator aborted: motion was stopped on purpose.
@@ -126,9 +128,10 @@ impl fmt::Display for FaultKind {
             Self::Device { severity, code } => match code {
                 500 => f.write_str("emergency stop"),
                 2504 => f.write_str("collision"),
-                _ => write!(f, "machine error {code:04}, severity {severity}"),
+                _ => write!(f, "alarm {code:04}, severity {severity}"),
             },
-            Self::Transport => f.write_str("link fault"),
+            Self::Transport => f.write_str("disconnected"),
+            Self::PortMissing => f.write_str("port missing"),
             Self::LockedOut => f.write_str("motion locked out"),
             Self::Aborted => f.write_str("aborted by the operator"),
             Self::Refused => f.write_str("the station refused to move"),

@@ -21,7 +21,7 @@ use super::pipeline::scan_ref;
 use super::worker::{ScanResult, WorkerError};
 use crate::api::{
     Event, FaultKind, JobKind, JobPhase, JobStatus, MachineFault, MachineState, MachineStatus,
-    PreparingJob, Reply, Request, StationStatus,
+    PreparingJob, Reply, Request, ScanRef, StationStatus,
 };
 use crate::geometry::sweep::mesh::MeshPart;
 use crate::plan::ProfileKey;
@@ -51,6 +51,11 @@ pub enum Input {
         job: String,
         key: ProfileKey,
         result: Result<(), String>,
+    },
+    /// A worker's watch saw its idle machine stop: an alarm, an emergency stop, a lost line, a missing port.
+    Observed {
+        machine: String,
+        fault: WorkerError,
     },
     /// A worker cleared its machine (or could not).
     Cleared {
@@ -193,6 +198,7 @@ impl Core {
             } => self.scan_ended(&machine, key, result),
             Input::Stored { job, key, result } => self.stored(&job, key, result),
             Input::Cleared { machine, result } => self.cleared(&machine, result),
+            Input::Observed { machine, fault } => self.observed(&machine, fault),
             Input::Finished { job, result } => self.finished(&job, result),
         }
         self.dispatch();
@@ -434,29 +440,35 @@ impl Core {
             }
             if job.phase == JobPhase::Running {
                 let scan = scan_ref(&job.plan, key);
-                tracing::error!(job = %job.info.id, machine, scan = %job.plan.describe(key), error = %fault.message, "job stopped");
-                job.phase = JobPhase::Stopped {
-                    machine: Some(machine.to_string()),
-                    scan: Some(scan.clone()),
-                    reason: format!(
-                        "{} of part {}: {}",
-                        job.plan.describe(key),
-                        job.info.part,
-                        fault.message
-                    ),
-                    next_step: CLEAR_TO_CONTINUE.to_string(),
-                };
-                let event = Event::JobStopped {
-                    job: job.info.id.clone(),
-                    machine: Some(machine.to_string()),
-                    scan: Some(scan),
-                    reason: fault.message.clone(),
-                    next_step: CLEAR_TO_CONTINUE.to_string(),
-                };
+                let reason = format!(
+                    "{} of part {}: {}",
+                    job.plan.describe(key),
+                    job.info.part,
+                    fault.message
+                );
+                let event = stop(job, Some(machine), Some(scan), reason, CLEAR_TO_CONTINUE);
                 self.publish(event);
             }
         }
         self.abort_done_if_stopped();
+    }
+
+    /// The watch of an idle machine saw it stop (an alarm, an emergency stop, its line or port gone): it is
+    /// locked out until the operator's clear, and a running job stops, since the machine can take no more of its
+    /// scans. A machine busy with an order hears of the fault through the order's end instead.
+    fn observed(&mut self, machine: &str, fault: WorkerError) {
+        let Some(slot) = self.slot(machine).filter(|s| s.state == MachineState::Idle) else {
+            return;
+        };
+        slot.state = MachineState::LockedOut {
+            fault: fault.fault(),
+        };
+        let Some(job) = self.job.as_mut().filter(|j| j.phase == JobPhase::Running) else {
+            return;
+        };
+        let reason = format!("part {}: {}", job.info.part, fault.message);
+        let event = stop(job, Some(machine), None, reason, CLEAR_TO_CONTINUE);
+        self.publish(event);
     }
 
     /// A scan that ended well with a hole in it: the machine is ready; the profile is scanned again once, and a
@@ -514,28 +526,15 @@ impl Core {
             return;
         };
         let next_step = "check the line to the machine (cable, controller), then run `zeroset clear`: the profile \
-                         is scanned again"
-            .to_string();
+                         is scanned again";
         let reason = format!(
             "{} of part {} has a hole again after a rescan: {}",
             job.plan.describe(key),
             job.info.part,
             error.message
         );
-        tracing::error!(job = %id, machine, %reason, "job stopped");
-        job.phase = JobPhase::Stopped {
-            machine: Some(machine.to_string()),
-            scan: Some(scan.clone()),
-            reason: reason.clone(),
-            next_step: next_step.clone(),
-        };
-        self.publish(Event::JobStopped {
-            job: id,
-            machine: Some(machine.to_string()),
-            scan: Some(scan),
-            reason,
-            next_step,
-        });
+        let event = stop(job, Some(machine), Some(scan), reason, next_step);
+        self.publish(event);
     }
 
     fn stored(&mut self, job_id: &str, key: ProfileKey, result: Result<(), String>) {
@@ -558,27 +557,14 @@ impl Core {
         if job.phase != JobPhase::Running {
             return;
         }
-        let next_step =
-            "free space or fix the data folder's permissions, then run `zeroset clear`".to_string();
+        let next_step = "free space or fix the data folder's permissions, then run `zeroset clear`";
         let reason = format!(
             "{} of part {}: its points could not be stored: {error}",
             job.plan.describe(key),
             job.info.part
         );
         let scan = scan_ref(&job.plan, key);
-        job.phase = JobPhase::Stopped {
-            machine: None,
-            scan: Some(scan.clone()),
-            reason: reason.clone(),
-            next_step: next_step.clone(),
-        };
-        let event = Event::JobStopped {
-            job: job_id.to_string(),
-            machine: None,
-            scan: Some(scan),
-            reason,
-            next_step,
-        };
+        let event = stop(job, None, Some(scan), reason, next_step);
         self.publish(event);
     }
 
@@ -636,22 +622,8 @@ impl Core {
                 let reason =
                     format!("job {job_id}: every profile is on disk, but {what} failed: {error}");
                 let next_step = "remove the cause, then run `zeroset clear` to finish it from its scans (nothing \
-                                 is scanned again), or `zeroset abort` to end it"
-                    .to_string();
-                tracing::error!(job = job_id, %reason, "job stopped");
-                job.phase = JobPhase::Stopped {
-                    machine: None,
-                    scan: None,
-                    reason: reason.clone(),
-                    next_step: next_step.clone(),
-                };
-                let event = Event::JobStopped {
-                    job: job_id.to_string(),
-                    machine: None,
-                    scan: None,
-                    reason,
-                    next_step,
-                };
+                                 is scanned again), or `zeroset abort` to end it";
+                let event = stop(job, None, None, reason, next_step);
                 self.publish(event);
                 return;
             }
@@ -903,6 +875,30 @@ impl Core {
             preparing: self.preparing.as_ref().map(|p| p.job.clone()),
             job,
         }
+    }
+}
+
+/// Stops `job` for `reason` (logged), waiting for what `next_step` says; the event that tells the operator.
+fn stop(
+    job: &mut Job,
+    machine: Option<&str>,
+    scan: Option<ScanRef>,
+    reason: String,
+    next_step: &str,
+) -> Event {
+    tracing::error!(job = %job.info.id, machine, %reason, "job stopped");
+    job.phase = JobPhase::Stopped {
+        machine: machine.map(str::to_string),
+        scan: scan.clone(),
+        reason: reason.clone(),
+        next_step: next_step.to_string(),
+    };
+    Event::JobStopped {
+        job: job.info.id.clone(),
+        machine: machine.map(str::to_string),
+        scan,
+        reason,
+        next_step: next_step.to_string(),
     }
 }
 

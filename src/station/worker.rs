@@ -27,6 +27,7 @@ use crate::analysis::RawPoint;
 use crate::api::{FaultKind, MachineFault};
 use crate::config::{MachineEntry, ProbeSettings, Safety};
 use crate::geometry::sweep::mesh::MeshPart;
+use watch::locks_motion;
 
 /// I++ error 0008, "Protocol error": what a controller answers to StartSession while it holds a session, and to
 /// other commands on a session it no longer holds.
@@ -92,15 +93,18 @@ pub fn spawn(
     daemon: mpsc::Sender<DaemonMsg>,
 ) -> WorkerHandle {
     let name = entry.name.clone();
-    spawn_on(name, line_connector(entry), probe, safety, daemon)
+    let watch = Some(watch::EVERY);
+    spawn_on(name, line_connector(entry), probe, safety, watch, daemon)
 }
 
-/// Starts the worker of the machine named `name`, reached through `connect`.
+/// Starts the worker of the machine named `name`, reached through `connect`; while idle it watches the machine
+/// every `watch` (none: only orders wake it).
 pub fn spawn_on(
     name: String,
     connect: Connector,
     probe: ProbeSettings,
     safety: Safety,
+    watch: Option<Duration>,
     daemon: mpsc::Sender<DaemonMsg>,
 ) -> WorkerHandle {
     let (orders, inbox) = mpsc::channel(4);
@@ -123,8 +127,9 @@ pub fn spawn_on(
         session: false,
         ball_radius: None,
         path: None,
+        fault: None,
     };
-    tokio::spawn(worker.run(inbox, daemon));
+    tokio::spawn(worker.run(inbox, watch, daemon));
     handle
 }
 
@@ -144,7 +149,7 @@ fn line_connector(entry: MachineEntry) -> Connector {
             None => open_pty(&port),
         };
         let line = line.map_err(|e| WorkerError {
-            kind: FaultKind::Transport,
+            kind: FaultKind::PortMissing,
             message: format!(
                 "machine {}: cannot open its line {port}: {e}; check the cable and that the controller is on, then run `zeroset clear`",
                 entry.name
@@ -169,6 +174,8 @@ struct Worker {
     ball_radius: Option<f64>,
     /// The surface around the probe as far as the station knows it, and its margin (mm): the last scan's.
     path: Option<(KnownPath, f64)>,
+    /// Why the machine may not move until the operator's clear: a failed order, or what the watch saw while idle.
+    fault: Option<WorkerError>,
 }
 
 /// How a scan order ended.
@@ -211,40 +218,96 @@ impl From<MachineError> for WorkerError {
 }
 
 impl Worker {
-    async fn run(mut self, mut inbox: mpsc::Receiver<Order>, daemon: mpsc::Sender<DaemonMsg>) {
-        while let Some(order) = inbox.recv().await {
-            match order {
-                Order::Scan {
-                    motion,
-                    part,
-                    pipeline,
-                } => {
-                    let key = motion.key;
-                    // Alarms from before this order were reported with the order they stopped.
-                    self.alarms();
-                    let result = self.scan(*motion, part.as_deref(), pipeline).await;
-                    let result = result.map_err(|e| self.failed(e));
-                    let report = DaemonMsg::Input(Input::ScanEnded {
-                        machine: self.name.clone(),
-                        key,
-                        result,
-                    });
-                    if daemon.send(report).await.is_err() {
-                        return;
-                    }
+    /// Takes orders one at a time; between them, every `watch`, looks at the machine (`watch`).
+    async fn run(
+        mut self,
+        mut inbox: mpsc::Receiver<Order>,
+        watch: Option<Duration>,
+        daemon: mpsc::Sender<DaemonMsg>,
+    ) {
+        let mut ticks = watch.map(|every| {
+            let mut ticks = tokio::time::interval(every);
+            ticks.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+            ticks
+        });
+        loop {
+            // What the machine raised comes before the next order: an order must not start on a machine that
+            // has just been stopped.
+            let wake = tokio::select! {
+                biased;
+                event = watch::next_event(&mut self.alarms), if ticks.is_some() => watch::Wake::Event(event),
+                order = inbox.recv() => match order {
+                    Some(order) => watch::Wake::Order(order),
+                    None => return,
+                },
+                _ = watch::tick(&mut ticks) => watch::Wake::Tick,
+            };
+            let order = match wake {
+                watch::Wake::Event(event) => {
+                    self.on_event(event, &daemon).await;
+                    continue;
                 }
-                Order::Clear { escape, reply } => {
-                    // An operator's clear lifts an abort, as it lifts every lockout.
-                    self.aborted.store(false, Ordering::SeqCst);
-                    if let (None, Some(cut)) = (&self.path, escape.cut.clone()) {
-                        self.path = Some(cut);
-                    }
-                    self.alarms();
-                    let result = self.clear(&escape).await.map_err(|e| self.failed(e));
-                    let _ = reply.send(result);
+                watch::Wake::Tick => {
+                    self.look(&daemon).await;
+                    continue;
                 }
+                watch::Wake::Order(order) => order,
+            };
+            if !self.execute(order, &daemon).await {
+                return;
             }
         }
+    }
+
+    /// Runs one order and reports how it ended; false once the daemon is gone.
+    async fn execute(&mut self, order: Order, daemon: &mpsc::Sender<DaemonMsg>) -> bool {
+        match order {
+            Order::Scan {
+                motion,
+                part,
+                pipeline,
+            } => {
+                let key = motion.key;
+                let result = match self.standing_fault() {
+                    Some(fault) => Err(fault),
+                    None => self.scan(*motion, part.as_deref(), pipeline).await,
+                };
+                let result = result.map_err(|e| self.failed(e));
+                let report = DaemonMsg::Input(Input::ScanEnded {
+                    machine: self.name.clone(),
+                    key,
+                    result,
+                });
+                if daemon.send(report).await.is_err() {
+                    return false;
+                }
+            }
+            Order::Clear { escape, reply } => {
+                // An operator's clear lifts an abort, as it lifts every lockout.
+                self.aborted.store(false, Ordering::SeqCst);
+                self.fault = None;
+                if let (None, Some(cut)) = (&self.path, escape.cut.clone()) {
+                    self.path = Some(cut);
+                }
+                self.alarms();
+                let result = self.clear(&escape).await.map_err(|e| self.failed(e));
+                let _ = reply.send(result);
+            }
+        }
+        true
+    }
+
+    /// The fault that keeps the machine from moving before a clear, with any alarm raised since it was last
+    /// looked at: a scan order meeting one ends with it, sending nothing.
+    fn standing_fault(&mut self) -> Option<WorkerError> {
+        if let Some((kind, message)) = self
+            .alarms()
+            .into_iter()
+            .find(|(kind, _)| locks_motion(*kind))
+        {
+            self.fault.get_or_insert(WorkerError { kind, message });
+        }
+        self.fault.clone()
     }
 
     /// A failed order's error led by the alarms raised meanwhile (an emergency stop ends a scan with "transaction
@@ -256,22 +319,26 @@ impl Worker {
             return error;
         }
         let alarms = self.alarms();
-        if error.kind == FaultKind::Transport {
-            *self.link.lock().expect("not poisoned") = None;
-            self.alarms = None;
-            self.session = false;
+        if matches!(error.kind, FaultKind::Transport | FaultKind::PortMissing) {
+            self.drop_link();
         }
         // Set up again after any failure: a lost link, a restarted controller, a tool change.
         self.ball_radius = None;
-        let Some((first_kind, _)) = alarms.first() else {
-            return error;
+        let error = match alarms.first() {
+            None => error,
+            Some((first_kind, _)) => {
+                let mut message: Vec<String> =
+                    alarms.iter().map(|(_, text)| text.clone()).collect();
+                message.push(error.message);
+                WorkerError {
+                    kind: *first_kind,
+                    message: message.join("; "),
+                }
+            }
         };
-        let mut message: Vec<String> = alarms.iter().map(|(_, text)| text.clone()).collect();
-        message.push(error.message);
-        WorkerError {
-            kind: *first_kind,
-            message: message.join("; "),
-        }
+        // Nothing moves until the operator's clear.
+        self.fault.get_or_insert_with(|| error.clone());
+        error
     }
 
     fn client(&self) -> Option<Link> {
@@ -392,28 +459,67 @@ impl Worker {
         Ok(here)
     }
 
+    /// The machine's errors cleared on its link (opened if need be): on a new link starting a session does it; a
+    /// session the machine no longer holds is opened again.
+    async fn clear_errors(&mut self) -> Result<Link, WorkerError> {
+        let client = self.connect()?;
+        if !self.session {
+            self.open_session(&client).await?;
+            return Ok(client);
+        }
+        match client.clear_all_errors().await {
+            Ok(()) => {}
+            Err(error) if is_protocol_error(&error) => {
+                // The machine no longer holds this worker's session (it was restarted, or its line dropped and
+                // came back): start over on it.
+                tracing::warn!(machine = %self.name, "the machine lost the session; opening it again");
+                self.session = false;
+                self.open_session(&client).await?;
+            }
+            Err(error) => return Err(error.into()),
+        }
+        Ok(client)
+    }
+
+    /// Forgets a link that failed, so that the next use opens it again.
+    fn drop_link(&mut self) {
+        *self.link.lock().expect("not poisoned") = None;
+        self.alarms = None;
+        self.session = false;
+    }
+
     /// Clears the machine's errors (on a new link, starting a session does; a session the machine no longer
     /// holds is opened again) and takes the probe clear of the part by a way out checked against the model.
     async fn clear(&mut self, model: &EscapeModel) -> Result<(), WorkerError> {
-        let client = self.connect()?;
-        if self.session {
-            match client.clear_all_errors().await {
-                Ok(()) => {}
-                Err(error) if is_protocol_error(&error) => {
-                    // The machine no longer holds this worker's session (it was restarted, or its line dropped
-                    // and came back): start over on it.
-                    tracing::warn!(machine = %self.name, "the machine lost the session; opening it again");
-                    self.session = false;
-                    self.open_session(&client).await?;
-                }
-                Err(error) => return Err(error.into()),
+        // A link that died unseen (the controller restarted) is opened again, in the same clear.
+        let client = match self.clear_errors().await {
+            Err(error) if error.kind == FaultKind::Transport => {
+                tracing::warn!(machine = %self.name, %error, "the link was lost; opening it again to clear");
+                self.drop_link();
+                self.clear_errors().await?
             }
-        } else {
-            self.open_session(&client).await?;
-        }
+            result => result?,
+        };
         // The way out first, with the tool the machine has on: changing it moves the head, so the station sets
         // the machine up (`prepare`) only once the probe is at the clearance height.
         self.ball_radius = None;
+        let here = self.position(&client).await?;
+        if here.z < self.safety.clearance_z_mm - AT_HEIGHT_TOLERANCE_MM {
+            self.leave_the_part(&client, here, model).await?;
+        }
+        self.path = None;
+        self.prepare().await?;
+        Ok(())
+    }
+
+    /// Takes the probe from `here`, below the clearance height, up to it by a way out checked against what is
+    /// known of the part, with the ball the machine has on.
+    async fn leave_the_part(
+        &mut self,
+        client: &Link,
+        here: Point3<f64>,
+        model: &EscapeModel,
+    ) -> Result<(), WorkerError> {
         let radius = client.tool_radius().await?;
         if !(radius > 0.0 && radius <= self.safety.max_ball_radius_mm) {
             return Err(WorkerError {
@@ -425,10 +531,8 @@ impl Worker {
                 ),
             });
         }
-        let here = self.position(&client).await?;
         let path = self.path.as_ref().map(|(path, margin)| (path, *margin));
-        let moves = plan_escape(here, path, radius, &self.safety, model)
-        .map_err(|e| WorkerError {
+        let moves = plan_escape(here, path, radius, &self.safety, model).map_err(|e| WorkerError {
             kind: FaultKind::Refused,
             message: format!(
                 "machine {}: {e}; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
@@ -438,8 +542,6 @@ impl Worker {
         for target in moves {
             client.go_to(xyz(&target)).await?;
         }
-        self.path = None;
-        self.prepare().await?;
         Ok(())
     }
 
@@ -641,6 +743,8 @@ fn is_protocol_error(error: &MachineError) -> bool {
 fn xyz(p: &Point3<f64>) -> Xyz {
     Xyz::new(p.x, p.y, p.z)
 }
+
+mod watch;
 
 #[cfg(test)]
 mod tests;

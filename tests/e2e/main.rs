@@ -7,6 +7,7 @@ mod fit_and_deviate;
 mod lockout;
 mod lost_points;
 mod machine_link;
+mod machine_state;
 mod nut;
 mod readme;
 mod responsive;

@@ -94,6 +94,12 @@ impl Sim {
         answer.trim().to_string()
     }
 
+    /// Kills the simulator (as a controller switched off): its lines close, its links are left dangling.
+    pub fn kill(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
     /// The transcript of a machine's line (the simulator's default: zeroset-sim-MACHINE-PID.log in the temp dir).
     pub fn transcript(&self, machine: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("zeroset-sim-{machine}-{}.log", self.child.id()))

@@ -596,3 +596,57 @@ fn abort_stops_a_machine_that_is_leaving_the_part_after_a_clear() {
         .iter()
         .any(|e| matches!(e, Effect::Clear { .. } | Effect::Scan { .. })));
 }
+
+#[test]
+fn a_fault_seen_on_an_idle_machine_locks_it_out_and_no_job_starts_until_a_clear() {
+    let mut bench = Bench::new();
+    let lost = WorkerError {
+        kind: FaultKind::Transport,
+        message: "machine cmm1: its line was lost while idle (the line closed)".into(),
+    };
+    let effects = bench.core.handle(Input::Observed {
+        machine: MACHINE.into(),
+        fault: lost.clone(),
+    });
+    assert!(
+        !touches_a_machine(&effects),
+        "a fault never moves a machine"
+    );
+    let MachineState::LockedOut { fault } = bench.machine() else {
+        panic!("locked out, not idle: {:?}", bench.machine());
+    };
+    assert_eq!(fault, lost.fault());
+    assert!(bench
+        .machine()
+        .to_string()
+        .starts_with("locked out (disconnected)"));
+    let (_, effects) = bench.request(Request::Teach {
+        part: "propeller".into(),
+    });
+    assert!(
+        matches!(reply_of(&effects), Some(Reply::Error { message }) if message.contains("cmm1") && message.contains("zeroset clear")),
+        "no job on a machine whose line is gone"
+    );
+    bench.request(Request::Clear);
+    bench.core.handle(Input::Cleared {
+        machine: MACHINE.into(),
+        result: Ok(()),
+    });
+    assert_eq!(bench.machine(), MachineState::Idle);
+}
+
+#[test]
+fn a_fault_seen_while_a_machine_scans_is_left_to_the_scan_order() {
+    let mut bench = Bench::new();
+    let key = scanned(&bench.start_teach()).unwrap();
+    let effects = bench.core.handle(Input::Observed {
+        machine: MACHINE.into(),
+        fault: estop(),
+    });
+    assert!(effects.is_empty(), "the order's end reports it");
+    assert!(matches!(bench.machine(), MachineState::Scanning { .. }));
+    assert_eq!(bench.phase(), JobPhase::Running);
+    bench.scan_ended(key, Err(estop()));
+    assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
+    assert!(matches!(bench.phase(), JobPhase::Stopped { .. }));
+}

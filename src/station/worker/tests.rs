@@ -132,7 +132,7 @@ fn worker_on(machine: MockMachine) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) 
 
 fn worker_with(connector: Connector) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
     let (daemon, reports) = mpsc::channel(8);
-    let handle = spawn_on("cmm1".into(), connector, probe(), safety(), daemon);
+    let handle = spawn_on("cmm1".into(), connector, probe(), safety(), None, daemon);
     (handle, reports)
 }
 
@@ -692,4 +692,119 @@ async fn an_abort_before_the_first_connection_still_stops_the_order_until_a_clea
     clear(&worker, EscapeModel::default())
         .await
         .expect("cleared");
+}
+
+fn observed(message: Option<DaemonMsg>) -> WorkerError {
+    match message {
+        Some(DaemonMsg::Input(Input::Observed { machine, fault })) => {
+            assert_eq!(machine, "cmm1");
+            fault
+        }
+        _ => panic!("expected what the watch saw"),
+    }
+}
+
+/// An idle machine under a fast watch, its alarms sent through `alarms`, GetErrStatusE answered by `in_error`.
+fn watched(
+    alarms: &broadcast::Sender<Event>,
+    in_error: impl Fn() -> Result<bool, MachineError> + Send + 'static,
+) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
+    let mut machine = MockMachine::new();
+    let alarms = alarms.clone();
+    machine
+        .expect_events()
+        .returning(move || alarms.subscribe());
+    machine.expect_start_session().returning(|| Ok(()));
+    machine.expect_in_error().returning(in_error);
+    machine.expect_go_to().never();
+    let machine: Link = Arc::new(machine);
+    let (daemon, reports) = mpsc::channel(8);
+    let watch = Some(Duration::from_millis(20));
+    let handle = spawn_on(
+        "cmm1".into(),
+        Box::new(move || Ok(machine.clone())),
+        probe(),
+        safety(),
+        watch,
+        daemon,
+    );
+    (handle, reports)
+}
+
+#[tokio::test]
+async fn an_emergency_stop_on_an_idle_machine_is_seen_at_once_and_the_next_scan_sends_nothing() {
+    let (alarms, _) = broadcast::channel(8);
+    let (worker, mut reports) = watched(&alarms, || Ok(false));
+    // A few looks at a healthy machine report nothing.
+    tokio::time::sleep(Duration::from_millis(100)).await;
+    assert!(reports.try_recv().is_err());
+    let estop = zeroset_drivers::wire::DeviceError::new(
+        3,
+        500,
+        zeroset_drivers::wire::WireString::new("E0000").unwrap(),
+        zeroset_drivers::wire::WireString::new("Emergency stop").unwrap(),
+    )
+    .unwrap();
+    alarms.send(Event::Unsolicited(estop)).unwrap();
+    let fault = observed(
+        tokio::time::timeout(Duration::from_secs(2), reports.recv())
+            .await
+            .unwrap(),
+    );
+    assert_eq!(
+        fault.kind,
+        FaultKind::Device {
+            severity: 3,
+            code: 500
+        }
+    );
+    assert!(fault.message.contains("while idle"), "{}", fault.message);
+    // Seen once, not at every look.
+    tokio::time::sleep(Duration::from_millis(100)).await;
+    assert!(reports.try_recv().is_err());
+    // An order that meets the stopped machine ends with its fault and sends nothing (the mock refuses any GoTo).
+    let (pipeline, _analysis) = mpsc::channel(8);
+    send_scan(&worker, motion(), pipeline).await;
+    let error = scan_result(&mut reports).await.unwrap_err();
+    assert_eq!(error.kind, fault.kind, "{}", error.message);
+}
+
+#[tokio::test]
+async fn a_line_that_went_dead_while_idle_is_seen_by_the_look() {
+    let (alarms, _) = broadcast::channel(8);
+    let (_worker, mut reports) = watched(&alarms, || Err(lost("GetErrStatusE")));
+    let fault = observed(
+        tokio::time::timeout(Duration::from_secs(2), reports.recv())
+            .await
+            .unwrap(),
+    );
+    assert_eq!(fault.kind, FaultKind::Transport, "{}", fault.message);
+    assert!(fault.message.contains("GetErrStatusE"), "{}", fault.message);
+}
+
+#[tokio::test]
+async fn a_port_that_cannot_be_opened_is_seen_before_any_job() {
+    let (daemon, mut reports) = mpsc::channel(8);
+    let connector: Connector = Box::new(|| {
+        Err(WorkerError {
+            kind: FaultKind::PortMissing,
+            message: "machine cmm1: cannot open its line /dev/ttyUSB7: No such file or directory"
+                .into(),
+        })
+    });
+    let _worker = spawn_on(
+        "cmm1".into(),
+        connector,
+        probe(),
+        safety(),
+        Some(Duration::from_millis(20)),
+        daemon,
+    );
+    let fault = observed(
+        tokio::time::timeout(Duration::from_secs(2), reports.recv())
+            .await
+            .unwrap(),
+    );
+    assert_eq!(fault.kind, FaultKind::PortMissing);
+    assert!(fault.message.contains("/dev/ttyUSB7"), "{}", fault.message);
 }
