@@ -384,7 +384,7 @@ fn profile_edges(profile: &MasterProfile) -> Vec<SharpEdge> {
         .collect();
     let edges = find_sharp_edges(&points, &normals);
     for edge in &edges {
-        tracing::info!(profile = %profile.name, x_mm = profile.x_mm, apex_mm = ?edge.apex, turn_deg = edge.turn_rad.to_degrees(), "sharp edge");
+        tracing::info!(profile = %profile.name, x_mm = profile.x_mm, apex_y_mm = edge.apex[0], apex_z_mm = edge.apex[1], turn_deg = edge.turn_rad.to_degrees(), "sharp edge");
     }
     edges
 }

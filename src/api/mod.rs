@@ -95,6 +95,15 @@ pub enum JobKind {
     Inspect,
 }
 
+impl std::fmt::Display for JobKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Teach => "teach",
+            Self::Inspect => "inspect",
+        })
+    }
+}
+
 /// What a job is about: enough for a watcher that joins late to lay out its display.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JobInfo {

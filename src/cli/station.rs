@@ -137,8 +137,10 @@ fn init_logging(folder: &Path) -> anyhow::Result<()> {
                 .with_filter(filter()),
         )
         .with(
+            // Colours only for a person at a terminal: a log file or a pipe gets plain text.
             fmt::layer()
                 .compact()
+                .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
                 .with_writer(std::io::stderr)
                 .with_filter(filter()),
         )

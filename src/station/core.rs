@@ -8,6 +8,7 @@
 //! operator's `zeroset clear`; an abort sends AbortE to the scanning machines and nothing else, never a clear or
 //! a move; a job does not start while any machine is locked out.
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use nalgebra::Point3;
@@ -141,6 +142,8 @@ pub struct Core {
     job: Option<Job>,
     /// The request owed an answer once every machine has cleared.
     clearing: Option<RequestId>,
+    /// The operator's commands not answered yet, as the log names them: each answer is logged with its command.
+    commands: BTreeMap<RequestId, String>,
     effects: Vec<Effect>,
 }
 
@@ -175,6 +178,7 @@ impl Core {
                 })
                 .collect(),
             preparing: None,
+            commands: BTreeMap::new(),
             job: reopened,
             clearing: None,
             effects: Vec::new(),
@@ -211,6 +215,20 @@ impl Core {
     }
 
     fn reply(&mut self, id: RequestId, reply: Reply) {
+        if let Some(command) = self.commands.remove(&id) {
+            match &reply {
+                Reply::Error { message } => {
+                    tracing::warn!(%command, outcome = %message, "operator command refused")
+                }
+                Reply::Done { message } => {
+                    tracing::info!(%command, outcome = %message, "operator command done")
+                }
+                Reply::Started { job } => {
+                    tracing::info!(%command, job = %job.id, "operator command started a job")
+                }
+                _ => {}
+            }
+        }
         self.emit(Effect::Reply { id, reply });
     }
 
@@ -223,6 +241,19 @@ impl Core {
     }
 
     fn request(&mut self, id: RequestId, request: Request) {
+        // What an operator asks of the station is logged, and its answer (`reply`); looking (status, watch,
+        // report) is not.
+        let command = match &request {
+            Request::Teach { part } => Some(format!("teach {part}")),
+            Request::Inspect { part, serial } => Some(format!("inspect {part} --serial {serial}")),
+            Request::Abort => Some("abort".to_string()),
+            Request::Clear => Some("clear".to_string()),
+            Request::Status | Request::Report { .. } | Request::Subscribe => None,
+        };
+        if let Some(command) = command {
+            tracing::info!(%command, "operator command");
+            self.commands.insert(id, command);
+        }
         match request {
             Request::Status => {
                 let status = self.status();
@@ -334,7 +365,7 @@ impl Core {
             return self.refuse(id, message);
         }
         let info = job.info.clone();
-        tracing::info!(job = %info.id, kind = ?info.kind, part = %info.part, "job started");
+        tracing::info!(job = %info.id, kind = %info.kind, part = %info.part, "job started");
         self.job = Some(job);
         self.emit(Effect::StartPipeline);
         self.publish(Event::JobStarted {
@@ -692,7 +723,7 @@ impl Core {
                         machine: machine.clone(),
                     });
                 }
-                tracing::warn!(job = %job_id, machines = ?scanning, "aborted by the operator");
+                tracing::warn!(job = %job_id, machines = %scanning.join(", "), "aborted by the operator");
                 self.abort_done_if_stopped();
                 let mut message =
                     format!("job {job_id} is aborted (its scans so far stay on disk)");

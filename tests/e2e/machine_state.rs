@@ -66,6 +66,37 @@ fn an_emergency_stop_and_a_lost_simulator_show_in_status_and_one_clear_recovers_
         station.cli_ok(&["status"]).contains("machine cmm1: idle"),
         "cleared"
     );
+
+    // The log an operator reads: each command and its outcome, the faults seen, and no terminal colour codes in
+    // a log file.
+    let log =
+        std::fs::read_to_string(station.root.path().join("logs/zeroset-daemon.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = log
+        .lines()
+        .map(|line| serde_json::from_str(line).expect("one JSON object per line"))
+        .collect();
+    let said = |message: &str, command: &str| {
+        lines
+            .iter()
+            .filter(|l| l["fields"]["message"] == message && l["fields"]["command"] == command)
+            .count()
+    };
+    assert_eq!(said("operator command", "clear"), 3, "{log}");
+    assert_eq!(said("operator command done", "clear"), 2, "{log}");
+    assert_eq!(said("operator command refused", "clear"), 1, "{log}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l["fields"]["message"] == "machine fault while idle"
+                && l["fields"]["kind"] == "emergency stop"),
+        "{log}"
+    );
+    let stderr = std::fs::read_to_string(station.root.path().join("daemon-1.stderr")).unwrap();
+    assert!(
+        !stderr.contains('\x1b'),
+        "no ANSI codes in a log file: {stderr}"
+    );
+    assert!(stderr.contains("operator command"), "{stderr}");
 }
 
 #[test]

@@ -478,12 +478,41 @@ impl<T: AsyncRead + AsyncWrite + Unpin> Actor<T> {
     }
 }
 
-/// The command as errors name it: its text, cut short when long (a curve scan's nominals).
+/// The command as errors name it: its text, or when long (a curve scan's nominals) its name and how many
+/// arguments it had, for an operator's message; the whole text goes to the log as a field ([`full_text`]).
 pub(crate) fn label(call: &Call) -> String {
     const MAX: usize = 80;
     let text = call.to_string();
     if text.len() <= MAX {
         return text;
     }
-    format!("{}...", &text[..MAX])
+    format!("{}(... {} arguments)", call.name, call.args.len())
+}
+
+/// The command's whole text, for the log.
+pub(crate) fn full_text(call: &Call) -> Arc<str> {
+    call.to_string().into()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::{Arg, Name, Number};
+
+    fn call(name: &str, count: usize) -> Call {
+        let args = (0..count)
+            .map(|i| Arg::Number(Number::from_f64(100.0 + i as f64 * 0.125).unwrap()))
+            .collect();
+        Call::new(Name::new(name).unwrap(), args)
+    }
+
+    #[test]
+    fn a_long_command_is_named_by_its_name_and_argument_count_and_logged_whole() {
+        let short = call("GoTo", 3);
+        assert_eq!(label(&short), short.to_string());
+        let scan = call("ScanOnCurve", 1200);
+        assert_eq!(label(&scan), "ScanOnCurve(... 1200 arguments)");
+        let whole = full_text(&scan);
+        assert!(whole.len() > 5000 && whole.ends_with("249.875)"), "{whole}");
+    }
 }

@@ -21,7 +21,7 @@ use crate::machine::{
     MoveReporting, MoveReports, ScanPoint, ScanStream, Scanning, Speeds, TransportError, Xyz,
 };
 use crate::wire::{Call, Data, EventTag, Tag, WireError};
-use actor::{label, Actor, Reply, Request};
+use actor::{full_text, label, Actor, Reply, Request};
 
 /// How long the client waits for the machine.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -83,6 +83,7 @@ impl Client {
         let origin = Origin {
             machine: self.machine.clone(),
             command: label(&call),
+            text: full_text(&call),
         };
         let (replies, receiver) = mpsc::unbounded_channel();
         // If the task is gone, `replies` is dropped with the request and the receiver reports it.
@@ -114,6 +115,7 @@ impl Client {
         let origin = Origin {
             machine: self.machine.clone(),
             command: label(&call),
+            text: full_text(&call),
         };
         let data = self.transact(call).await?;
         read(&data).map_err(|why| origin.bad_reply(why))
@@ -136,6 +138,7 @@ impl Client {
             let origin = Origin {
                 machine: self.machine.clone(),
                 command: what.to_owned(),
+                text: what.into(),
             };
             origin.error(ErrorKind::InvalidArgument(problem))
         })
@@ -158,11 +161,15 @@ type Replies = mpsc::UnboundedReceiver<Reply>;
 #[derive(Clone)]
 struct Origin {
     machine: Arc<str>,
+    /// As the operator's message names it (`label`).
     command: String,
+    /// All of it, for the log.
+    text: Arc<str>,
 }
 
 impl Origin {
     fn error(&self, kind: ErrorKind) -> Error {
+        tracing::warn!(machine = %self.machine, command = %self.text, error = %kind, "machine command failed");
         Error::new(self.machine.clone(), self.command.clone(), kind)
     }
 
