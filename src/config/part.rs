@@ -9,7 +9,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{finite, read_toml, ConfigError};
+use super::{finite, parse_toml, read_text, ConfigError};
 pub use crate::analysis::ReferenceSettings;
 use crate::geometry::poly::MAX_DEGREE;
 
@@ -92,7 +92,12 @@ pub struct ToleranceEntry {
 impl PartConfig {
     /// Reads and checks the file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let config: PartConfig = read_toml(path)?;
+        Self::from_text(&read_text(path)?, path)
+    }
+
+    /// Parses and checks the text of the file at `path` (which errors name).
+    pub(crate) fn from_text(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let config: PartConfig = parse_toml(text, path)?;
         config.check().map_err(|problem| ConfigError::Invalid {
             path: path.to_owned(),
             problem,

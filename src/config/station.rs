@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::{finite, folder_of, read_toml, resolve, ConfigError};
+use super::{finite, folder_of, parse_toml, read_text, resolve, ConfigError};
 
 /// The whole station file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -131,26 +131,37 @@ impl Pose {
 impl StationConfig {
     /// Reads and checks the file; relative paths become absolute against its folder.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let mut config: StationConfig = read_toml(path)?;
+        let mut config = Self::from_text(&read_text(path)?, path)?;
+        config.resolve_paths(&folder_of(path)?);
+        Ok(config)
+    }
+
+    /// Parses and checks the text of the file at `path` (which errors name, and which `file` holds); its
+    /// paths are left as written.
+    pub(crate) fn from_text(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let mut config: StationConfig = parse_toml(text, path)?;
         config.check().map_err(|problem| ConfigError::Invalid {
             path: path.to_owned(),
             problem,
         })?;
         config.file = path.to_owned();
-        let folder = folder_of(path)?;
-        for relative in [
-            &mut config.folders.data,
-            &mut config.folders.reports,
-            &mut config.folders.logs,
-            &mut config.control.socket,
-            &mut config.parts,
-        ] {
-            *relative = resolve(&folder, relative);
-        }
-        for machine in &mut config.machines {
-            machine.port = resolve(&folder, &machine.port);
-        }
         Ok(config)
+    }
+
+    /// Makes every path absolute against `folder`, the file's (absolute: see [`folder_of`]).
+    pub(crate) fn resolve_paths(&mut self, folder: &Path) {
+        for relative in [
+            &mut self.folders.data,
+            &mut self.folders.reports,
+            &mut self.folders.logs,
+            &mut self.control.socket,
+            &mut self.parts,
+        ] {
+            *relative = resolve(folder, relative);
+        }
+        for machine in &mut self.machines {
+            machine.port = resolve(folder, &machine.port);
+        }
     }
 
     /// The file of the part named `part`.
