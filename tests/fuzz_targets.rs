@@ -325,6 +325,36 @@ fn part_config_loader_survives_mutated_part_files() {
     mutation_run("part_config", zeroset::config::fuzz::part_config);
 }
 
+/// The shipped propeller part file with `from` replaced by `to`, as the fuzzer might have edited it.
+fn propeller_with(from: &str, to: &str) -> Vec<u8> {
+    let text =
+        std::fs::read_to_string(repo("config/parts/propeller.toml")).expect("the shipped part");
+    assert!(text.contains(from), "the shipped part has no {from:?}");
+    text.replacen(from, to, 1).into_bytes()
+}
+
+/// Inputs that failed a target once, kept so that they cannot come back. Each was accepted by the part loader
+/// and planned into machine coordinates that are infinite, NaN or not a rigid turn.
+#[test]
+fn part_files_that_once_broke_the_plan_are_refused() {
+    for (from, to) in [
+        // Instance C turned by 2 * 1e308 degrees: an infinite angle, NaN coordinates.
+        ("step_deg = 120.0", "step_deg = 1e308"),
+        // A turn about a point at 1e308 mm shifts by more than f64 holds.
+        (
+            "axis_point_mm = [0.0, 0.0, 0.0]",
+            "axis_point_mm = [1e308, 1e308, 1e308]",
+        ),
+        // A direction whose length overflows normalises to zero: a "rotation" that scales.
+        (
+            "axis_direction = [0.0, 0.0, 1.0]",
+            "axis_direction = [1e308, 0.0, 1e308]",
+        ),
+    ] {
+        zeroset::config::fuzz::part_config(&propeller_with(from, to));
+    }
+}
+
 /// Writes every target's seeds to `fuzz/corpus/TARGET/`, one file each, named by index.
 #[test]
 #[ignore = "writes cargo-fuzz's seed corpora; run by fuzz/seed-corpora.sh"]

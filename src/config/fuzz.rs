@@ -25,7 +25,7 @@ const PART_FILE: &str = "/fuzz/config/parts/part.toml";
 
 /// A station file's text as [`StationConfig::load`] reads it. A file it accepts: writes back to TOML that
 /// reads as the same configuration; gives timeouts that make `Duration`s (the machine workers build them)
-/// and a finite placement of the part; and has only absolute, plain paths once resolved. A file it refuses
+/// and a rigid placement of the part; and has only absolute, plain paths once resolved. A file it refuses
 /// is refused with a message that names the file.
 pub fn station_config(data: &[u8]) {
     // `load` reads with `read_to_string`, which refuses a file that is not UTF-8 before parsing.
@@ -52,7 +52,7 @@ pub fn station_config(data: &[u8]) {
             );
         }
     }
-    assert_finite_isometry(&config.part_to_machine.isometry());
+    assert_rigid(&config.part_to_machine.isometry());
     let folder = path.parent().expect("the file has a folder");
     config.resolve_paths(folder);
     let paths = [
@@ -77,7 +77,7 @@ pub fn station_config(data: &[u8]) {
 }
 
 /// A part file's text as [`PartConfig::load`] reads it. A file it accepts: writes back to TOML that reads as
-/// the same part; and plans, for every instance's profiles, teach scans whose every coordinate is finite
+/// the same part; and plans rigid placements of its instances and, for every instance's profiles, teach scans whose every coordinate is finite
 /// and can be sent to a machine (the station sends them as I++ numbers). A file it refuses is refused with a
 /// message that names the file.
 pub fn part_config(data: &[u8]) {
@@ -96,7 +96,7 @@ pub fn part_config(data: &[u8]) {
     assert_eq!(reread, part, "written back as\n{written}");
     let plan = Plan::new(&part, Isometry3::identity());
     for key in plan.inspect_scans() {
-        assert_finite_isometry(&plan.instance_to_machine(key.instance));
+        assert_rigid(&plan.instance_to_machine(key.instance));
         let scan = plan.in_plane_scan(key);
         // InPlaneScan's own rule: the heading is a point apart from the start.
         assert_ne!(
@@ -138,10 +138,16 @@ fn check_refusal(error: &ConfigError, path: &Path) {
     );
 }
 
-fn assert_finite_isometry(isometry: &Isometry3<f64>) {
+/// A placement is a rigid motion: finite, its rotation a unit quaternion.
+fn assert_rigid(isometry: &Isometry3<f64>) {
     let matrix = isometry.to_homogeneous();
     assert!(
         matrix.iter().all(|v| v.is_finite()),
         "placement {matrix} is not finite"
+    );
+    let norm = isometry.rotation.quaternion().norm();
+    assert!(
+        (norm - 1.0).abs() < 1e-9,
+        "placement {matrix} is not a rotation (quaternion norm {norm})"
     );
 }

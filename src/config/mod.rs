@@ -86,6 +86,17 @@ fn finite(values: &[f64]) -> bool {
     values.iter().all(|v| v.is_finite())
 }
 
+/// The farthest from the origin, along any axis, that a point or shift of a configuration may lie, mm: a
+/// kilometre, far beyond any machine's table, and small enough that placing the part (turns about a point,
+/// shifts) cannot overflow. Finite was not enough: the part fuzz target's checks
+/// (`config::fuzz`) showed an axis point at 1e308 mm turned into a machine coordinate of infinity.
+const MAX_COORDINATE_MM: f64 = 1e6;
+
+/// Whether every number lies within [`MAX_COORDINATE_MM`] of zero (NaN does not).
+fn in_reach(values: &[f64]) -> bool {
+    values.iter().all(|v| v.abs() <= MAX_COORDINATE_MM)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

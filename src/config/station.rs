@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::{finite, folder_of, parse_toml, read_text, resolve, ConfigError};
+use super::{
+    finite, folder_of, in_reach, parse_toml, read_text, resolve, ConfigError, MAX_COORDINATE_MM,
+};
 
 /// The whole station file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -206,15 +208,11 @@ impl StationConfig {
             ));
         }
         let pose = &self.part_to_machine;
-        if !finite(&[
-            pose.x_mm,
-            pose.y_mm,
-            pose.z_mm,
-            pose.rot_y_deg,
-            pose.rot_z_deg,
-        ]) {
+        if !in_reach(&[pose.x_mm, pose.y_mm, pose.z_mm])
+            || !finite(&[pose.rot_y_deg, pose.rot_z_deg])
+        {
             return Err(format!(
-                "part_to_machine {pose:?} has a value that is not a finite number"
+                "part_to_machine {pose:?}: give a shift within {MAX_COORDINATE_MM} mm and finite angles"
             ));
         }
         Ok(())
@@ -486,5 +484,20 @@ mod tests {
                 ..Pose::default()
             }
         );
+        // A shift is a length on the table: one beyond a kilometre is a mistake, and near f64's range it
+        // overflows once a part's point is added.
+        for shift in ["{ x_mm = 1e308 }", "{ z_mm = -1000000.5 }"] {
+            let (_dir, path) = edited(|t| {
+                t.replace(
+                    "part_to_machine = { x_mm = 0.0, y_mm = 0.0, z_mm = 0.0, rot_z_deg = 0.0 }",
+                    &format!("part_to_machine = {shift}"),
+                )
+            });
+            let message = StationConfig::load(&path).unwrap_err().to_string();
+            assert!(
+                message.contains("give a shift within 1000000 mm and finite angles"),
+                "{shift}: {message}"
+            );
+        }
     }
 }
