@@ -9,6 +9,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+#[doc(hidden)]
+pub mod fuzz;
 mod results;
 mod states;
 

@@ -9,7 +9,7 @@ use std::path::Path;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::{finite, read_toml, ConfigError};
+use super::{finite, in_reach, parse_toml, read_text, ConfigError, MAX_COORDINATE_MM};
 pub use crate::analysis::ReferenceSettings;
 use crate::geometry::poly::MAX_DEGREE;
 
@@ -92,7 +92,12 @@ pub struct ToleranceEntry {
 impl PartConfig {
     /// Reads and checks the file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let config: PartConfig = read_toml(path)?;
+        Self::from_text(&read_text(path)?, path)
+    }
+
+    /// Parses and checks the text of the file at `path` (which errors name).
+    pub(crate) fn from_text(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let config: PartConfig = parse_toml(text, path)?;
         config.check().map_err(|problem| ConfigError::Invalid {
             path: path.to_owned(),
             problem,
@@ -147,9 +152,12 @@ impl PartConfig {
     }
 }
 
-/// Whether a direction can be normalised.
+/// Whether a direction can be normalised: its length neither 0 nor overflowing (a length of infinity
+/// normalises to the zero vector, which the part fuzz target's checks
+/// showed turning instances by a rotation that is not one).
 fn usable_direction(v: [f64; 3]) -> bool {
-    finite(&v) && Vector3::from(v).norm() > 1e-12
+    let norm = Vector3::from(v).norm();
+    norm > 1e-12 && norm.is_finite()
 }
 
 impl Instances {
@@ -169,17 +177,26 @@ impl Instances {
                 self.master, self.names
             ));
         }
-        if !finite(&self.axis_point_mm) || !usable_direction(self.axis_direction) {
+        if !in_reach(&self.axis_point_mm) || !usable_direction(self.axis_direction) {
             return Err(format!(
-                "[instances] needs a finite axis_point_mm and a non-zero axis_direction (got {:?} and \
-                 {:?})",
+                "[instances] needs an axis_point_mm within {MAX_COORDINATE_MM} mm of the origin and a \
+                 non-zero axis_direction (got {:?} and {:?})",
                 self.axis_point_mm, self.axis_direction
             ));
         }
-        if !self.step_deg.is_finite() || (self.names.len() > 1 && self.step_deg == 0.0) {
+        if self.names.len() > 1 && self.step_deg == 0.0 {
+            return Err(
+                "[instances] step_deg = 0 would put every instance in the same place; give the turn \
+                 from one instance to the next"
+                    .into(),
+            );
+        }
+        // Beyond a turn the instances' angles lose their meaning, and at 1e308 (the fuzz target's checks showed) they
+        // overflow to infinity and the plan's coordinates to NaN.
+        if self.step_deg.is_nan() || self.step_deg.abs() > 360.0 {
             return Err(format!(
-                "[instances] step_deg = {} would put every instance in the same place; give the turn \
-                 from one instance to the next",
+                "[instances] step_deg = {}: give the turn from one instance to the next, from -360 to 360 \
+                 degrees",
                 self.step_deg
             ));
         }
@@ -191,9 +208,10 @@ impl ProfileEntry {
     /// The plane's normal is x: the start must lie in the plane, and the probe and the scan must move in it.
     fn check(&self) -> Result<(), String> {
         let name = &self.name;
-        if !finite(&self.start_mm) || !self.x_mm.is_finite() {
+        if !in_reach(&self.start_mm) || !in_reach(&[self.x_mm]) {
             return Err(format!(
-                "profile {name}: x_mm and start_mm must be finite numbers"
+                "profile {name}: x_mm and start_mm must be numbers within {MAX_COORDINATE_MM} mm of the \
+                 origin"
             ));
         }
         if (self.start_mm[0] - self.x_mm).abs() > 1e-6 {
@@ -492,5 +510,28 @@ mod tests {
 
         let message = refusal(|c| c.instances.names.push("A".into()));
         assert!(message.contains("lists \"A\" twice"), "{message}");
+
+        // The part fuzz target's finds: values that are finite but overflow once the instances are placed.
+        let message = refusal(|c| c.instances.step_deg = 1e308);
+        assert!(
+            message.contains("step_deg = 100000000000000000000") && message.contains("-360 to 360"),
+            "{message}"
+        );
+        assert!(refusal(|c| c.instances.step_deg = -361.0).contains("step_deg = -361"));
+        let message = refusal(|c| c.instances.axis_point_mm = [0.0, 1.0e7, 0.0]);
+        assert!(
+            message.contains("axis_point_mm within 1000000 mm"),
+            "{message}"
+        );
+        let message = refusal(|c| c.instances.axis_direction = [1e308, 1e308, 0.0]);
+        assert!(message.contains("non-zero axis_direction"), "{message}");
+        let message = refusal(|c| {
+            c.profiles[0].x_mm = -2e6;
+            c.profiles[0].start_mm[0] = -2e6;
+        });
+        assert!(
+            message.contains("profile r100: x_mm and start_mm must be numbers within 1000000 mm"),
+            "{message}"
+        );
     }
 }

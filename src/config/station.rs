@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::{finite, folder_of, read_toml, resolve, ConfigError};
+use super::{
+    finite, folder_of, in_reach, parse_toml, read_text, resolve, ConfigError, MAX_COORDINATE_MM,
+};
 
 /// The whole station file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -131,26 +133,37 @@ impl Pose {
 impl StationConfig {
     /// Reads and checks the file; relative paths become absolute against its folder.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let mut config: StationConfig = read_toml(path)?;
+        let mut config = Self::from_text(&read_text(path)?, path)?;
+        config.resolve_paths(&folder_of(path)?);
+        Ok(config)
+    }
+
+    /// Parses and checks the text of the file at `path` (which errors name, and which `file` holds); its
+    /// paths are left as written.
+    pub(crate) fn from_text(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let mut config: StationConfig = parse_toml(text, path)?;
         config.check().map_err(|problem| ConfigError::Invalid {
             path: path.to_owned(),
             problem,
         })?;
         config.file = path.to_owned();
-        let folder = folder_of(path)?;
-        for relative in [
-            &mut config.folders.data,
-            &mut config.folders.reports,
-            &mut config.folders.logs,
-            &mut config.control.socket,
-            &mut config.parts,
-        ] {
-            *relative = resolve(&folder, relative);
-        }
-        for machine in &mut config.machines {
-            machine.port = resolve(&folder, &machine.port);
-        }
         Ok(config)
+    }
+
+    /// Makes every path absolute against `folder`, the file's (absolute: see [`folder_of`]).
+    pub(crate) fn resolve_paths(&mut self, folder: &Path) {
+        for relative in [
+            &mut self.folders.data,
+            &mut self.folders.reports,
+            &mut self.folders.logs,
+            &mut self.control.socket,
+            &mut self.parts,
+        ] {
+            *relative = resolve(folder, relative);
+        }
+        for machine in &mut self.machines {
+            machine.port = resolve(folder, &machine.port);
+        }
     }
 
     /// The file of the part named `part`.
@@ -195,15 +208,11 @@ impl StationConfig {
             ));
         }
         let pose = &self.part_to_machine;
-        if !finite(&[
-            pose.x_mm,
-            pose.y_mm,
-            pose.z_mm,
-            pose.rot_y_deg,
-            pose.rot_z_deg,
-        ]) {
+        if !in_reach(&[pose.x_mm, pose.y_mm, pose.z_mm])
+            || !finite(&[pose.rot_y_deg, pose.rot_z_deg])
+        {
             return Err(format!(
-                "part_to_machine {pose:?} has a value that is not a finite number"
+                "part_to_machine {pose:?}: give a shift within {MAX_COORDINATE_MM} mm and finite angles"
             ));
         }
         Ok(())
@@ -475,5 +484,20 @@ mod tests {
                 ..Pose::default()
             }
         );
+        // A shift is a length on the table: one beyond a kilometre is a mistake, and near f64's range it
+        // overflows once a part's point is added.
+        for shift in ["{ x_mm = 1e308 }", "{ z_mm = -1000000.5 }"] {
+            let (_dir, path) = edited(|t| {
+                t.replace(
+                    "part_to_machine = { x_mm = 0.0, y_mm = 0.0, z_mm = 0.0, rot_z_deg = 0.0 }",
+                    &format!("part_to_machine = {shift}"),
+                )
+            });
+            let message = StationConfig::load(&path).unwrap_err().to_string();
+            assert!(
+                message.contains("give a shift within 1000000 mm and finite angles"),
+                "{shift}: {message}"
+            );
+        }
     }
 }

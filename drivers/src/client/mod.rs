@@ -4,7 +4,7 @@
 
 mod actor;
 mod calls;
-mod replies;
+pub(crate) mod replies;
 mod role;
 
 use std::collections::VecDeque;
