@@ -7,8 +7,9 @@
 //! Run: `cargo bench --bench fault_campaign -- --faults 1000 --seed 7` (cargo builds the release binary). The
 //! e2e suite runs the same code with 100 faults (`cargo test --test e2e fault_campaign`).
 
-// The e2e suite's station, simulator and campaign, shared as they are: this program uses part of their helpers.
-#[allow(dead_code)]
+// The e2e suite's station, simulator and campaign, shared as they are: this program uses part of their helpers,
+// and cargo builds a bench with cfg(test) but without the test harness, so their test modules come without tests.
+#[allow(dead_code, unused_imports)]
 #[path = "../tests/e2e/campaign/mod.rs"]
 mod campaign;
 #[allow(dead_code)]

@@ -23,6 +23,21 @@ pub(crate) fn point_counts(report: &PartReport) -> Counts {
         .collect()
 }
 
+/// Points per profile that the statistics use (not flagged as a cusp): what the history counts. How many a
+/// profile flags varies with the probe's noise from one inspection to the next.
+pub(crate) fn statistic_counts(report: &PartReport) -> Counts {
+    report
+        .instances
+        .iter()
+        .flat_map(|i| {
+            i.profiles.iter().map(|p| {
+                let used = p.points.iter().filter(|point| !point.flagged).count();
+                ((i.name.clone(), p.name.clone()), used)
+            })
+        })
+        .collect()
+}
+
 /// Two points of a profile closer than a micrometre: one measured twice (a resumed scan appended to a cut one
 /// would repeat the start).
 pub(crate) fn repeated_points(report: &PartReport) -> Vec<String> {
@@ -34,9 +49,9 @@ pub(crate) fn repeated_points(report: &PartReport) -> Vec<String> {
                 .iter()
                 .enumerate()
                 .filter(|(i, a)| {
-                    profile.points[i + 1..].iter().any(|b| {
-                        (Point3::from(a.centre) - Point3::from(b.centre)).norm() <= 1e-3
-                    })
+                    profile.points[i + 1..]
+                        .iter()
+                        .any(|b| (Point3::from(a.centre) - Point3::from(b.centre)).norm() <= 1e-3)
                 })
                 .map(|(_, a)| a.centre)
                 .collect::<Vec<_>>();
@@ -53,14 +68,20 @@ pub(crate) fn repeated_points(report: &PartReport) -> Vec<String> {
     found
 }
 
-/// Profiles whose point count differs from the uninterrupted inspection's (a lost or an extra stretch).
-pub(crate) fn count_differences(what: &str, counts: &Counts, whole: &Counts) -> Vec<String> {
+/// Profiles whose point count differs from `whole`'s, which `source` names (e.g. an uninterrupted inspection's:
+/// a lost or an extra stretch).
+pub(crate) fn count_differences(
+    what: &str,
+    counts: &Counts,
+    whole: &Counts,
+    source: &str,
+) -> Vec<String> {
     let mut found = Vec::new();
     for (key, expected) in whole {
         match counts.get(key) {
             Some(n) if n == expected => {}
             Some(n) => found.push(format!(
-                "{what}: instance {} profile {}: {n} points, an uninterrupted inspection has {expected}",
+                "{what}: instance {} profile {}: {n} points, {source} has {expected}",
                 key.0, key.1
             )),
             None => found.push(format!(
@@ -78,14 +99,18 @@ pub(crate) fn count_differences(what: &str, counts: &Counts, whole: &Counts) -> 
     found
 }
 
-/// The history's rows of one serial (`zeroset report --export csv`): its points per profile (the history counts
-/// the points its statistics use, without the flagged ones, so it is compared with the history of an
-/// uninterrupted inspection), and every profile there more than once.
+/// The history's rows of one serial (`zeroset report --export csv`): its points per profile (those its
+/// statistics use, see [`statistic_counts`]), and every profile there more than once.
 pub(crate) fn history_counts(csv: &str, serial: &str) -> (Counts, Vec<String>) {
     let mut reader = csv::Reader::from_reader(csv.as_bytes());
     let headers = match reader.headers() {
         Ok(headers) => headers.clone(),
-        Err(e) => return (Counts::new(), vec![format!("the history export does not read: {e}")]),
+        Err(e) => {
+            return (
+                Counts::new(),
+                vec![format!("the history export does not read: {e}")],
+            )
+        }
     };
     let column = |name: &str| headers.iter().position(|h| h == name);
     let (Some(s), Some(i), Some(p), Some(n)) = (
@@ -180,11 +205,11 @@ mod tests {
     fn a_short_profile_a_missing_one_and_a_doubled_history_row_are_found() {
         let whole = counts(&[("A", "r200", 391), ("A", "r300", 380)]);
         let cut = counts(&[("A", "r200", 351)]);
-        let found = count_differences("SN-1", &cut, &whole);
+        let found = count_differences("SN-1", &cut, &whole, "an uninterrupted inspection");
         assert_eq!(found.len(), 2, "{found:?}");
         assert!(found[0].contains("r200: 351 points, an uninterrupted inspection has 391"));
         assert!(found[1].contains("r300 is missing"));
-        assert!(count_differences("SN-1", &whole, &whole).is_empty());
+        assert!(count_differences("SN-1", &whole, &whole, "it").is_empty());
         let csv = "serial,finished,instance,profile,points\n\
                    SN-1,t,A,r200,391\nSN-1,t,A,r300,380\nSN-1,t,A,r300,380\nSN-2,t,A,r200,10\n";
         let (counts, found) = history_counts(csv, "SN-1");

@@ -145,8 +145,13 @@ mod tests {
         for kind in Kind::ALL {
             assert!(first.iter().any(|(f, _)| f.kind == kind), "{kind:?}");
         }
-        let lines: Vec<_> = first.iter().filter_map(|(f, _)| f.control_line("cmm1")).collect();
-        assert!(lines.iter().any(|l| l.starts_with("fault cmm1 drop-lines ")));
+        let lines: Vec<_> = first
+            .iter()
+            .filter_map(|(f, _)| f.control_line("cmm1"))
+            .collect();
+        assert!(lines
+            .iter()
+            .any(|l| l.starts_with("fault cmm1 drop-lines ")));
         assert!(lines.iter().all(|l| !l.contains("kill")));
         // Every line is one the simulator reads.
         for line in &lines {

@@ -78,8 +78,6 @@ struct Rig {
     station: Station,
     transcript: TranscriptWatch,
     whole: Counts,
-    /// The history's points per profile of the uninterrupted inspection.
-    whole_history: Counts,
     profiles: Vec<String>,
     /// The latest fault and when its dead line comes back, if it was a disconnect.
     last: Option<Fault>,
@@ -94,22 +92,20 @@ impl Rig {
         station.cli_ok(&["inspect", PART, "--serial", "SN-WHOLE"]);
         let whole = checks::point_counts(&read_report(&station, "SN-WHOLE").expect("a report"));
         let profiles: BTreeSet<String> = whole.keys().map(|(_, p)| p.clone()).collect();
-        let export = station.cli_ok(&["report", "--export", "csv"]);
-        let (whole_history, found) = checks::history_counts(&export, "SN-WHOLE");
-        assert!(found.is_empty(), "{found:?}");
         let mut rig = Rig {
             station,
             transcript,
             whole,
-            whole_history,
             profiles: profiles.into_iter().collect(),
             last: None,
             line_back: None,
         };
         let found = rig.transcript.read_on();
-        tally
-            .violations
-            .extend(found.into_iter().map(|v| format!("uninterrupted inspection: {v}")));
+        tally.violations.extend(
+            found
+                .into_iter()
+                .map(|v| format!("uninterrupted inspection: {v}")),
+        );
         rig
     }
 
@@ -157,7 +153,10 @@ impl Job<'_> {
                 Ok(event) => event,
                 Err(RecvTimeoutError::Timeout) => {
                     let status = self.rig.station.cli(&["status"]).stdout;
-                    self.violation(format!("no event for {} s; status: {status}", QUIET.as_secs()));
+                    self.violation(format!(
+                        "no event for {} s; status: {status}",
+                        QUIET.as_secs()
+                    ));
                     return self.give_up(&status);
                 }
                 Err(RecvTimeoutError::Disconnected) => {
@@ -193,8 +192,12 @@ impl Job<'_> {
                     ));
                 }
                 Event::JobStarted { done, .. } => {
-                    let forgotten: Vec<ScanRef> =
-                        self.done.iter().filter(|s| !done.contains(s)).cloned().collect();
+                    let forgotten: Vec<ScanRef> = self
+                        .done
+                        .iter()
+                        .filter(|s| !done.contains(s))
+                        .cloned()
+                        .collect();
                     for scan in forgotten {
                         self.violation(format!(
                             "instance {} profile {} was complete but the resumed job does not count it",
@@ -211,7 +214,10 @@ impl Job<'_> {
                     }
                     let gaps = checks::stop_message_gaps(&event);
                     if !gaps.is_empty() {
-                        self.violation(format!("a stop does not name {}: {event:?}", gaps.join(", ")));
+                        self.violation(format!(
+                            "a stop does not name {}: {event:?}",
+                            gaps.join(", ")
+                        ));
                     }
                     if let Err(last) = self.clear() {
                         return self.give_up(&last);
@@ -221,7 +227,9 @@ impl Job<'_> {
                     self.check_finished();
                     return End::Finished;
                 }
-                Event::JobAborted { .. } | Event::JobFailed { .. } | Event::ReferenceSaved { .. } => {
+                Event::JobAborted { .. }
+                | Event::JobFailed { .. }
+                | Event::ReferenceSaved { .. } => {
                     self.violation(format!("the inspection ended so: {event:?}"));
                     return self.give_up(&format!("{event:?}"));
                 }
@@ -267,7 +275,10 @@ impl Job<'_> {
         if run.success {
             return Ok(());
         }
-        self.violation(format!("inspect refused after a clear: {}", run.stderr.trim()));
+        self.violation(format!(
+            "inspect refused after a clear: {}",
+            run.stderr.trim()
+        ));
         Err(run.stderr)
     }
 
@@ -300,7 +311,9 @@ impl Job<'_> {
     /// after restarting the daemon (all an operator can do short of a jog).
     fn clear(&mut self) -> Result<(), String> {
         if let Some(back) = self.rig.line_back.take() {
-            std::thread::sleep(back.saturating_duration_since(Instant::now()) + Duration::from_millis(300));
+            std::thread::sleep(
+                back.saturating_duration_since(Instant::now()) + Duration::from_millis(300),
+            );
         }
         let mut last = String::new();
         for restarted in [false, true] {
@@ -340,12 +353,17 @@ impl Job<'_> {
         let said = format!("{} | {}", status.trim(), last.trim());
         let gaps = checks::final_message_gaps(&said, MACHINE, PART, &self.rig.profiles);
         if !gaps.is_empty() {
-            self.violation(format!("its last word does not name {}: {said}", gaps.join(", ")));
+            self.violation(format!(
+                "its last word does not name {}: {said}",
+                gaps.join(", ")
+            ));
         }
         self.read_transcript();
-        self.tally
-            .jobs_stuck
-            .push(format!("{} ({}): {said}", self.serial, self.faults.join(", ")));
+        self.tally.jobs_stuck.push(format!(
+            "{} ({}): {said}",
+            self.serial,
+            self.faults.join(", ")
+        ));
         End::Stuck
     }
 
@@ -356,16 +374,26 @@ impl Job<'_> {
         match read_report(&self.rig.station, &self.serial) {
             Ok(report) => {
                 let counts = checks::point_counts(&report);
-                let mut found = checks::count_differences("report", &counts, &self.rig.whole);
+                let mut found = checks::count_differences(
+                    "report",
+                    &counts,
+                    &self.rig.whole,
+                    "an uninterrupted inspection",
+                );
                 found.extend(checks::repeated_points(&report));
-                let export = self.rig.station.cli(&["report", "--export", "csv", "--last", "100000"]);
+                let export = self
+                    .rig
+                    .station
+                    .cli(&["report", "--export", "csv", "--last", "100000"]);
                 let (history, doubled) = checks::history_counts(&export.stdout, &self.serial);
                 found.extend(doubled);
                 if !history.is_empty() {
+                    let used = checks::statistic_counts(&report);
                     found.extend(checks::count_differences(
                         "history",
                         &history,
-                        &self.rig.whole_history,
+                        &used,
+                        "the report",
                     ));
                 }
                 for violation in found {
@@ -391,7 +419,11 @@ impl Job<'_> {
         // The job's latest faults: what led to it.
         let latest = &self.faults[self.faults.len().saturating_sub(3)..];
         let more = if self.faults.len() > 3 { "..., " } else { "" };
-        let line = format!("{} (after {more}{}): {what}", self.serial, latest.join(", "));
+        let line = format!(
+            "{} (after {more}{}): {what}",
+            self.serial,
+            latest.join(", ")
+        );
         eprintln!("VIOLATION {line}");
         self.tally.violations.push(line);
     }

@@ -283,7 +283,11 @@ mod tests {
             "2.2 < 00009 PtMeas(X(1))",
         ]);
         assert_eq!(found.len(), 1, "{found:?}");
-        assert!(found[0].contains("a new session came between"), "{}", found[0]);
+        assert!(
+            found[0].contains("a new session came between"),
+            "{}",
+            found[0]
+        );
         assert!(found[0].contains("(dropped)"), "{}", found[0]);
     }
 
@@ -298,7 +302,11 @@ mod tests {
             "2.2 < 00031 GoTo(X(1))",
         ]);
         assert_eq!(found.len(), 1, "{found:?}");
-        assert!(found[0].contains("0500") && found[0].contains("00031 GoTo"), "{}", found[0]);
+        assert!(
+            found[0].contains("0500") && found[0].contains("00031 GoTo"),
+            "{}",
+            found[0]
+        );
     }
 
     #[test]
