@@ -51,6 +51,7 @@ pub(crate) fn run(options: &Options) -> Tally {
             faults: Vec::new(),
             done: HashSet::new(),
             since: 0,
+            at: None,
             budget: options.faults,
         };
         let began = Instant::now();
@@ -139,6 +140,8 @@ struct Job<'a> {
     done: HashSet<ScanRef>,
     /// Events towards the next fault's moment: points, or profiles done.
     since: usize,
+    /// The scan under way and its latest point's index, None between scans: where a fault went in.
+    at: Option<(ScanRef, usize)>,
     budget: usize,
 }
 
@@ -182,7 +185,9 @@ impl Job<'_> {
                 _ => false,
             };
             match &event {
+                Event::Point { scan, index, .. } => self.at = Some((scan.clone(), *index)),
                 Event::ProfileDone { scan, .. } => {
+                    self.at = None;
                     self.done.insert(scan.clone());
                 }
                 Event::ScanStarted { scan, .. } if self.done.contains(scan) => {
@@ -285,7 +290,13 @@ impl Job<'_> {
     /// Puts a fault in; after a kill, the new daemon's watcher.
     fn inject(&mut self, fault: Fault, moment: Moment) -> Option<Watcher> {
         *self.tally.injected.entry(fault.kind).or_default() += 1;
-        self.faults.push(format!("{fault} ({moment})"));
+        let place = match &self.at {
+            Some((scan, index)) => {
+                format!("in {} {} after point {index}", scan.instance, scan.profile)
+            }
+            None => "between scans".to_string(),
+        };
+        self.faults.push(format!("{fault} ({moment}, {place})"));
         self.rig.last = Some(fault);
         if let Some(line) = fault.control_line(MACHINE) {
             let answer = self.rig.station.sim.control(&line);
