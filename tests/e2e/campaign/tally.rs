@@ -116,6 +116,9 @@ impl Tally {
             let _ = writeln!(out, "could not go on: {stuck}");
         }
         let _ = writeln!(out, "violations: {}", self.violations.len());
+        for (what, n) in self.violation_kinds() {
+            let _ = writeln!(out, "  {n:>5} {what}");
+        }
         for violation in &self.violations {
             let _ = writeln!(out, "  VIOLATION {violation}");
         }
@@ -125,6 +128,44 @@ impl Tally {
             self.transcripts.join(", ")
         );
         out
+    }
+
+    /// The violations counted by what went wrong.
+    pub(crate) fn violation_kinds(&self) -> BTreeMap<&'static str, usize> {
+        const KINDS: [(&str, &str); 8] = [
+            ("motion ", "motion after an error before ClearAllErrors"),
+            (
+                "that no injected fault explains",
+                "a collision or missing surface of the station's own",
+            ),
+            ("): report: ", "points lost or added in the report"),
+            (
+                "): history: ",
+                "the history not holding the inspection once, whole",
+            ),
+            ("scanned again", "a complete profile scanned again"),
+            (
+                "does not count it",
+                "a complete profile forgotten at a resume",
+            ),
+            (
+                "last word does not name",
+                "a job that could not go on, its message incomplete",
+            ),
+            (
+                "clear failed",
+                "clear kept failing until the daemon was restarted",
+            ),
+        ];
+        let mut kinds = BTreeMap::new();
+        for violation in &self.violations {
+            let kind = KINDS
+                .iter()
+                .find(|(mark, _)| violation.contains(mark))
+                .map_or("other", |(_, kind)| kind);
+            *kinds.entry(kind).or_default() += 1;
+        }
+        kinds
     }
 
     fn count(&self, counts: &BTreeMap<Kind, usize>, kind: Kind) -> usize {

@@ -39,6 +39,8 @@ struct Standing {
     at: f64,
     /// A StartSession came since (the simulator, as the spec says, clears errors then too).
     new_session: bool,
+    /// A motion was already reported in this error's window (one violation per window, not per command).
+    reported: bool,
 }
 
 /// Faults armed on the machine and not yet met (the simulator keeps one of each: arming twice arms once).
@@ -178,9 +180,10 @@ impl TranscriptWatch {
                 None
             }
             _ if MOTION.contains(&name) => {
-                let standing = self.standing.as_ref()?;
+                let standing = self.standing.as_mut().filter(|s| !s.reported)?;
+                standing.reported = true;
                 Some(format!(
-                    "motion {:.0} ms after an error, before ClearAllErrors{}: `{}` then `{}`",
+                    "motion {:.0} ms after an error, before ClearAllErrors{} (the first of this error's window): `{}` then `{}`",
                     (at - standing.at) * 1000.0,
                     if standing.new_session {
                         " (a new session came between)"
@@ -202,6 +205,7 @@ impl TranscriptWatch {
                 code: error_of(line).map_or(String::new(), |(_, code)| code.to_string()),
                 at,
                 new_session: false,
+                reported: false,
             });
         }
     }
@@ -264,13 +268,23 @@ mod tests {
             "100.200000 < 00012 GoTo(X(1),Y(2),Z(3))",
             "100.300000 < 00013 ClearAllErrors()",
             "100.400000 < 00014 GoTo(X(1),Y(2),Z(3))",
+            "100.500000 > 00014 ! Error(3, 2504, \"GoTo\", \"Collision\")",
+            "100.600000 < 00015 GoTo(X(1),Y(2),Z(9))",
+            "100.700000 < 00016 GoTo(X(1),Y(2),Z(10))",
         ]);
-        assert_eq!(found.len(), 1, "{found:?}");
+        // One per error's window: the first motion in it; and a collision with none armed is the station's own.
+        assert_eq!(found.len(), 3, "{found:?}");
         assert!(
             found[0].starts_with("motion 100 ms after an error") && found[0].contains("00012 GoTo"),
             "{}",
             found[0]
         );
+        assert!(
+            found[1].starts_with("a collision that no injected fault"),
+            "{}",
+            found[1]
+        );
+        assert!(found[2].contains("00015 GoTo"), "{}", found[2]);
     }
 
     #[test]
