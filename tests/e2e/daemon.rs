@@ -68,6 +68,35 @@ impl Station {
         station
     }
 
+    /// The propeller's station, taught, whose client gives up on a silent line after `seconds` (the default waits
+    /// minutes for homing): a lost line stops the job soon enough for a test.
+    pub fn quick(seconds: f64) -> Station {
+        Station::start_edited("propeller.toml", "station.toml", |table| {
+            let machines = table["machines"].as_array_mut().unwrap();
+            for machine in machines {
+                let machine = machine.as_table_mut().unwrap();
+                machine.insert("ack_timeout_s".into(), seconds.into());
+                machine.insert("reply_timeout_s".into(), seconds.into());
+            }
+        })
+        .with_taught_reference()
+    }
+
+    /// How the daemon ended if it is no longer running of its own accord (a crash), with the end of what it
+    /// wrote on its standard error; None while it runs (or after [`Station::kill_daemon`]).
+    pub fn daemon_ended(&mut self) -> Option<String> {
+        let status = self.daemon.as_mut()?.try_wait().ok().flatten()?;
+        self.daemon = None;
+        let log = self
+            .root
+            .path()
+            .join(format!("daemon-{}.stderr", self.daemons_started));
+        let text = std::fs::read_to_string(log).unwrap_or_default();
+        let tail: Vec<&str> = text.lines().rev().take(5).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        Some(format!("{status}: {}", tail.join(" | ")))
+    }
+
     pub fn start_daemon(&mut self) {
         self.daemons_started += 1;
         let log = std::fs::File::create(
@@ -232,6 +261,13 @@ impl Watcher {
                 return event;
             }
         }
+    }
+
+    /// The next event (kept in `seen`), or why none came: the time ran out, or the daemon went away.
+    pub fn next(&mut self, timeout: Duration) -> Result<Event, mpsc::RecvTimeoutError> {
+        let line = self.events.recv_timeout(timeout)?;
+        self.seen.push(line.clone());
+        Ok(parse_line::<EventLine>(&line).expect("an event line").event)
     }
 
     pub fn events(&self) -> Vec<Event> {

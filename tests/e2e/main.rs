@@ -1,8 +1,10 @@
 //! End-to-end tests of the `zeroset` binary: one test binary, shared helpers, the real executables. The
 //! simulator runs as `zeroset sim` on pseudo-terminals and the station's I++ client talks to it through them.
 
+mod campaign;
 mod daemon;
 mod errors;
+mod fault_campaign;
 mod fit_and_deviate;
 mod lockout;
 mod lost_points;

@@ -143,37 +143,12 @@ fn teach(station: &Station) {
     assert!(out.contains("reference saved"), "{out}");
 }
 
-/// Points per profile of an inspection report.
-pub fn point_counts(report: &PartReport) -> BTreeMap<(String, String), usize> {
-    report
-        .instances
-        .iter()
-        .flat_map(|i| {
-            i.profiles
-                .iter()
-                .map(|p| ((i.name.clone(), p.name.clone()), p.points.len()))
-        })
-        .collect()
-}
+pub(crate) use crate::campaign::checks::point_counts;
 
 /// No point of a profile appears twice (a resumed scan appended to a cut one would repeat the start).
 pub fn assert_no_repeated_points(report: &PartReport) {
-    for instance in &report.instances {
-        for profile in &instance.profiles {
-            for (i, a) in profile.points.iter().enumerate() {
-                for b in &profile.points[i + 1..] {
-                    let gap = (Point3::from(a.centre) - Point3::from(b.centre)).norm();
-                    assert!(
-                        gap > 1e-3,
-                        "instance {} profile {}: a point appears twice at {:?}",
-                        instance.name,
-                        profile.name,
-                        a.centre
-                    );
-                }
-            }
-        }
-    }
+    let repeated = crate::campaign::checks::repeated_points(report);
+    assert!(repeated.is_empty(), "{}", repeated.join("\n"));
 }
 
 #[test]
