@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use nalgebra::Point3;
 
-use super::escape::{EscapeModel, KnownPath};
+use super::escape::{EscapeModel, ScanPath};
 use super::finish::Outcome;
 use super::job::{Job, JobError};
 use super::journal::{JobDir, JobRecord, JobState};
@@ -793,18 +793,32 @@ impl Core {
             .as_ref()
             .and_then(|j| j.motions.values().next())
             .map_or(0.0, |m| m.margin_mm);
-        let cut: Vec<(String, KnownPath, f64)> =
-            open.map(|j| j.cut_paths.clone()).unwrap_or_default();
+        let cut: Vec<(String, ScanPath)> = open.map(|j| j.cut_paths.clone()).unwrap_or_default();
+        // Every scan the job plans, for a machine whose probe may be on any of them (after a restart).
+        let planned: Vec<ScanPath> = open
+            .map(|j| {
+                j.motions
+                    .values()
+                    .map(|m| ScanPath {
+                        name: m.name.clone(),
+                        path: m.path.clone(),
+                        margin_mm: m.margin_mm,
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
         let mut orders = Vec::new();
         for slot in &mut self.slots {
             if matches!(slot.state, MachineState::Scanning { .. }) {
                 continue;
             }
             let escape = EscapeModel {
-                cut: cut
+                paths: cut
                     .iter()
-                    .find(|(machine, _, _)| *machine == slot.name)
-                    .map(|(_, path, margin)| (path.clone(), *margin)),
+                    .filter(|(machine, _)| *machine == slot.name)
+                    .map(|(_, scan)| scan.clone())
+                    .chain(planned.iter().cloned())
+                    .collect(),
                 part: part.clone(),
                 deviation_margin_mm,
             };
@@ -832,7 +846,7 @@ impl Core {
         }
         // The cut scans' paths served their one way out.
         if let Some(job) = self.job.as_mut() {
-            job.cut_paths.retain(|(m, _, _)| m != machine);
+            job.cut_paths.retain(|(m, _)| m != machine);
         }
         self.resume_if_clear();
     }

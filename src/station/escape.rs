@@ -50,11 +50,36 @@ pub enum EscapeError {
     },
 }
 
+/// A scan's path, for a way out: the scan as the operator reads it, what is known of its surface, and how far
+/// off that surface the ball travels entering and leaving it (mm).
+#[derive(Debug, Clone)]
+pub struct ScanPath {
+    pub name: String,
+    pub path: KnownPath,
+    pub margin_mm: f64,
+}
+
+impl ScanPath {
+    /// How far a ball centre at `position` is from this scan: from its known surface, or from the vertical its
+    /// scan is entered by, whichever is nearer, mm.
+    pub fn distance_mm(&self, position: &Point3<f64>, ball_radius: f64) -> f64 {
+        let surface = nearest_on_path(&self.path, position).distance;
+        let entry = self.path.entry_offset(ball_radius, self.margin_mm);
+        let descent = if position.z >= entry.z {
+            (position.xy() - entry.xy()).norm()
+        } else {
+            (position - entry).norm()
+        };
+        surface.min(descent)
+    }
+}
+
 /// What a way out after a stop is planned from, besides the path the worker itself was on, and checked against.
 #[derive(Clone, Default)]
 pub struct EscapeModel {
-    /// The path of a scan a killed daemon cut short, with its margin (mm), for a worker that knows none.
-    pub cut: Option<(KnownPath, f64)>,
+    /// The scans the probe may be on, for a worker that knows none (a restarted daemon): the scans a killed daemon
+    /// cut short, with the points they measured, then every scan the job plans. The nearest is followed.
+    pub paths: Vec<ScanPath>,
     /// The taught part on the machine, every instance (none when teaching: then only the known path counts).
     pub part: Option<Arc<MeshPart>>,
     /// How far the real part may lie from the model, and then some: the job's scan margin, mm.

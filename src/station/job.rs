@@ -8,7 +8,7 @@ use std::sync::Arc;
 use nalgebra::{Point3, Vector3};
 
 use super::clearance;
-use super::escape::KnownPath;
+use super::escape::ScanPath;
 use super::journal::{file_stem, JobDir, JobRecord, JobState};
 use super::motion::{job_motions, ScanMotion};
 use super::pipeline::scan_ref;
@@ -36,7 +36,7 @@ pub struct Job {
     pub part_model: Option<Arc<MeshPart>>,
     /// The scans a killed daemon cut short, read from their partial files when the job was reopened: the machine
     /// that scanned each, the path its way out follows and its margin (mm).
-    pub cut_paths: Vec<(String, KnownPath, f64)>,
+    pub cut_paths: Vec<(String, ScanPath)>,
     pub remaining: Vec<ProfileKey>,
     pub stored: BTreeSet<ProfileKey>,
     /// Profiles already scanned again for a hole in their scan: a second hole stops the job.
@@ -329,7 +329,7 @@ impl Job {
 
     /// The surface around a profile whose scan was cut by a killed daemon, from its partial file: the machine
     /// that scanned it and the path for its way out. `None` when no such file is there.
-    fn cut_scan_path(&self, key: ProfileKey) -> Option<(String, KnownPath, f64)> {
+    fn cut_scan_path(&self, key: ProfileKey) -> Option<(String, ScanPath)> {
         let (header, points) = self.dir.read_partial(&scan_ref(&self.plan, key)).ok()??;
         let motion = self.motions.get(&key)?;
         let mut path = motion.path.clone();
@@ -343,7 +343,12 @@ impl Job {
                 }
             }
         }
-        Some((header.machine, path, motion.margin_mm))
+        let scan = ScanPath {
+            name: motion.name.clone(),
+            path,
+            margin_mm: motion.margin_mm,
+        };
+        Some((header.machine, scan))
     }
 
     /// Every profile of this job with a partial file on disk.

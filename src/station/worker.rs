@@ -18,7 +18,7 @@ use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
 
 use super::core::Input;
-use super::escape::{check_way_out, plan_escape, EscapeModel, KnownPath};
+use super::escape::{check_way_out, plan_escape, EscapeModel, ScanPath};
 use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
 use super::pipeline::PipelineMsg;
@@ -172,8 +172,8 @@ struct Worker {
     session: bool,
     /// The active tool's ball radius once the machine is set up for this station.
     ball_radius: Option<f64>,
-    /// The surface around the probe as far as the station knows it, and its margin (mm): the last scan's.
-    path: Option<(KnownPath, f64)>,
+    /// The surface around the probe as far as the station knows it: the last scan's.
+    path: Option<ScanPath>,
     /// Why the machine may not move until the operator's clear: a failed order, or what the watch saw while idle.
     fault: Option<WorkerError>,
 }
@@ -286,9 +286,6 @@ impl Worker {
                 // An operator's clear lifts an abort, as it lifts every lockout.
                 self.aborted.store(false, Ordering::SeqCst);
                 self.fault = None;
-                if let (None, Some(cut)) = (&self.path, escape.cut.clone()) {
-                    self.path = Some(cut);
-                }
                 self.alarms();
                 let result = self.clear(&escape).await.map_err(|e| self.failed(e));
                 let _ = reply.send(result);
@@ -464,7 +461,10 @@ impl Worker {
     async fn clear_errors(&mut self) -> Result<Link, WorkerError> {
         let client = self.connect()?;
         if !self.session {
+            // A new session starts with the machine's errors cleared (the spec's StartSession), and
+            // ClearAllErrors says so on the wire: no motion goes out after an error without it.
             self.open_session(&client).await?;
+            client.clear_all_errors().await?;
             return Ok(client);
         }
         match client.clear_all_errors().await {
@@ -531,14 +531,47 @@ impl Worker {
                 ),
             });
         }
-        let path = self.path.as_ref().map(|(path, margin)| (path, *margin));
-        let moves = plan_escape(here, path, radius, &self.safety, model).map_err(|e| WorkerError {
-            kind: FaultKind::Refused,
-            message: format!(
-                "machine {}: {e}; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
-                self.name, self.safety.clearance_z_mm
-            ),
-        })?;
+        // The scan the worker was on, else the job's scans nearest first (after a restart the worker knows none):
+        // the first whose way out is proven is taken; each is checked against its own path and the part model.
+        let mut candidates: Vec<&ScanPath> = model.paths.iter().collect();
+        candidates.sort_by(|a, b| {
+            a.distance_mm(&here, radius)
+                .total_cmp(&b.distance_mm(&here, radius))
+        });
+        let candidates: Vec<&ScanPath> = self.path.iter().chain(candidates).collect();
+        let mut refusal = None;
+        let mut moves = None;
+        for scan in &candidates {
+            match plan_escape(
+                here,
+                Some((&scan.path, scan.margin_mm)),
+                radius,
+                &self.safety,
+                model,
+            ) {
+                Ok(found) => {
+                    moves = Some(found);
+                    break;
+                }
+                Err(error) => {
+                    refusal
+                        .get_or_insert(format!("{error} (the nearest scan known: {})", scan.name));
+                }
+            }
+        }
+        let moves = match moves {
+            Some(moves) => moves,
+            // Off every known scan: straight up, if the part model proves it free.
+            None => plan_escape(here, None, radius, &self.safety, model).map_err(|e| WorkerError {
+                kind: FaultKind::Refused,
+                message: format!(
+                    "machine {}: {}; jog the probe above z = {} mm with the machine's pendant, then run `zeroset clear`",
+                    self.name,
+                    refusal.unwrap_or_else(|| e.to_string()),
+                    self.safety.clearance_z_mm
+                ),
+            })?,
+        };
         for target in moves {
             client.go_to(xyz(&target)).await?;
         }
@@ -558,7 +591,11 @@ impl Worker {
             .await?;
         let (client, radius) = self.prepare().await?;
         // From the descent on, the probe is near the part: a way out after a stop follows this scan's path.
-        self.path = Some((motion.path.clone(), motion.margin_mm));
+        self.path = Some(ScanPath {
+            name: motion.name.clone(),
+            path: motion.path.clone(),
+            margin_mm: motion.margin_mm,
+        });
         for target in &motion.approach {
             self.not_aborted()?;
             client.go_to(xyz(target)).await?;
@@ -645,7 +682,7 @@ impl Worker {
                 ),
             });
         }
-        let known = self.path.as_ref().map(|(path, _)| path);
+        let known = self.path.as_ref().map(|scan| &scan.path);
         check_way_out(here, &motion.retract, known, radius, &self.safety, part).map_err(|e| {
             WorkerError {
                 kind: FaultKind::Refused,
@@ -683,7 +720,7 @@ impl Worker {
                 quality: point.quality,
             };
             if teaching {
-                if let Some((path, _)) = self.path.as_mut() {
+                if let Some(ScanPath { path, .. }) = self.path.as_mut() {
                     if let Some(normal) = Vector3::from(raw.normal).try_normalize(1e-9) {
                         path.surface
                             .push(Point3::from(raw.centre) - normal * radius);
@@ -702,7 +739,7 @@ impl Worker {
             }
         }
         if teaching {
-            if let Some((path, _)) = self.path.as_mut() {
+            if let Some(ScanPath { path, .. }) = self.path.as_mut() {
                 path.closed = true;
             }
         }

@@ -15,6 +15,7 @@ use super::*;
 use crate::config::{ProbeSettings, Safety};
 use crate::plan::ProfileKey;
 use crate::station::clearance::{swept_moves, MoveKind};
+use crate::station::escape::KnownPath;
 use zeroset_drivers::machine::TransportError;
 
 const CLEARANCE_MM: f64 = 150.0;
@@ -66,6 +67,7 @@ fn curve_scan(path: &KnownPath) -> CurveScan {
 fn machine(positions: Vec<Xyz>, moves: Arc<Mutex<Vec<Xyz>>>, scan: Vec<ScanPoint>) -> MockMachine {
     let mut machine = bare_machine(positions, Some(moves), scan);
     machine.expect_start_session().returning(|| Ok(()));
+    machine.expect_clear_all_errors().returning(|| Ok(()));
     machine
 }
 
@@ -471,7 +473,11 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     let position = Xyz::new(100.0, 0.0, -21.0);
     let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
     let escape = EscapeModel {
-        cut: Some((circle(), MARGIN_MM)),
+        paths: vec![ScanPath {
+            name: "instance B, profile r300".into(),
+            path: circle(),
+            margin_mm: MARGIN_MM,
+        }],
         part: None,
         deviation_margin_mm: MARGIN_MM,
     };
@@ -538,6 +544,7 @@ async fn a_lost_link_is_opened_again_by_the_next_order_not_reused() {
             let moves = (*count > 1).then(|| moves.clone());
             let mut machine = bare_machine(positions, moves, Vec::new());
             machine.expect_start_session().returning(|| Ok(()));
+            machine.expect_clear_all_errors().returning(|| Ok(()));
             Ok(Arc::new(machine) as Link)
         })
     };
@@ -568,6 +575,11 @@ async fn a_clear_on_a_session_the_machine_lost_starts_it_again() {
             Ok(())
         });
     }
+    // The first clear's, on the session it has just opened; then the machine has lost the session.
+    machine
+        .expect_clear_all_errors()
+        .times(1)
+        .returning(|| Ok(()));
     machine.expect_clear_all_errors().returning(|| {
         let error = zeroset_drivers::wire::DeviceError::new(
             3,
@@ -807,4 +819,75 @@ async fn a_port_that_cannot_be_opened_is_seen_before_any_job() {
     );
     assert_eq!(fault.kind, FaultKind::PortMissing);
     assert!(fault.message.contains("/dev/ttyUSB7"), "{}", fault.message);
+}
+
+fn scan_path(name: &str, shift_y_mm: f64) -> ScanPath {
+    let mut path = circle();
+    for p in &mut path.surface {
+        p.y += shift_y_mm;
+    }
+    ScanPath {
+        name: name.into(),
+        path,
+        margin_mm: MARGIN_MM,
+    }
+}
+
+#[tokio::test]
+async fn after_a_restart_the_probe_leaves_by_the_scan_it_is_on_whichever_was_cut_last() {
+    // A restarted daemon knows an old cut scan 300 mm away and the job's planned scans: the ball under the circle
+    // leaves along the circle's path, the one it is on.
+    let position = Xyz::new(100.0, 0.0, -21.0);
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
+    let escape = EscapeModel {
+        paths: vec![
+            scan_path("instance A, profile r100", 300.0),
+            scan_path("instance B, profile r300", 0.0),
+        ],
+        part: None,
+        deviation_margin_mm: MARGIN_MM,
+    };
+    let planned = plan_escape(
+        Point3::new(position.x, position.y, position.z),
+        Some((&circle(), MARGIN_MM)),
+        1.0,
+        &safety(),
+        &escape,
+    )
+    .unwrap();
+    clear(&worker, escape).await.expect("cleared");
+    assert_eq!(
+        *moves.lock().unwrap(),
+        planned.iter().map(xyz_of).collect::<Vec<_>>()
+    );
+
+    // Far from every scan it knows, it refuses and names the nearest.
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let (worker, _reports) = worker_on(machine(
+        vec![Xyz::new(100.0, 150.0, 10.0)],
+        moves.clone(),
+        Vec::new(),
+    ));
+    let escape = EscapeModel {
+        paths: vec![
+            scan_path("instance A, profile r100", 300.0),
+            scan_path("instance B, profile r300", 0.0),
+        ],
+        part: None,
+        deviation_margin_mm: MARGIN_MM,
+    };
+    let error = clear(&worker, escape).await.unwrap_err();
+    assert_eq!(error.kind, FaultKind::Refused);
+    assert!(
+        error
+            .message
+            .contains("the nearest scan known: instance B, profile r300")
+            || error
+                .message
+                .contains("the nearest scan known: instance A, profile r100"),
+        "{}",
+        error.message
+    );
+    assert!(moves.lock().unwrap().is_empty());
 }

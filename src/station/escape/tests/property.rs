@@ -210,7 +210,7 @@ fn check_stop(
 fn a_way_out_from_any_stop_along_an_inspection_is_clear_of_the_real_part_or_refused() {
     let model = Section::naca(400, 0.0);
     let escape = EscapeModel {
-        cut: None,
+        paths: Vec::new(),
         part: Some(std::sync::Arc::new(model.mesh())),
         deviation_margin_mm: INSPECT_MARGIN_MM,
     };
