@@ -8,6 +8,7 @@ mod lockout;
 mod lost_points;
 mod machine_link;
 mod nut;
+mod operator;
 mod readme;
 mod responsive;
 mod sim;
