@@ -19,8 +19,8 @@ pub struct FitIpArgs {
     /// Point file: CSV with header y,z (a profile) or x,y,z (3-D), in mm.
     #[arg(long)]
     points: PathBuf,
-    /// Degree of the polynomial (of each profile, for a stack).
-    #[arg(long, default_value_t = 4)]
+    /// Degree of the polynomial (of each profile, for a stack), 1 to 16.
+    #[arg(long, default_value_t = 4, value_parser = degree)]
     degree: usize,
     #[arg(long, value_enum, default_value = "odr")]
     method: MethodArg,
@@ -37,6 +37,18 @@ pub struct FitIpArgs {
     /// The model file to write (JSON).
     #[arg(long)]
     out: PathBuf,
+}
+
+/// `--degree`: checked as an option, so that a degree out of range is a usage error, not a fault of the file.
+fn degree(text: &str) -> Result<usize, String> {
+    use crate::geometry::poly::MAX_DEGREE;
+    match text.parse::<usize>() {
+        Ok(d) if (1..=MAX_DEGREE).contains(&d) => Ok(d),
+        Ok(d) => Err(format!(
+            "degree {d} is not supported; give 1 to {MAX_DEGREE}"
+        )),
+        Err(e) => Err(format!("{e}; give a whole number from 1 to {MAX_DEGREE}")),
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, ValueEnum)]

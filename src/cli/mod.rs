@@ -1,9 +1,25 @@
 //! The `zeroset` command line: argument parsing and one module per command. Library errors are turned into one
 //! line an operator can act on: which file, which line, what is wrong.
 
+/// `println!` for a command's results: a reader that closes standard output (`| head`) ends the command quietly
+/// ([`exit::OutputClosed`]) instead of panicking. Returns `anyhow::Result<()>`.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::exit::write_out(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// [`outln!`] without the newline.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::cli::exit::write_out(format_args!($($arg)*))
+    };
+}
+
 mod control;
 pub mod demo;
 mod deviate;
+pub mod exit;
 mod fit;
 mod fit_supershape;
 mod mesh;
@@ -21,7 +37,8 @@ use crate::geometry::fit3l::FitMethod;
 #[command(
     name = "zeroset",
     version,
-    about = "Inspection-station controller: reference models from master scans and deviations of measured points (mm)"
+    about = "Inspection-station controller: reference models from master scans and deviations of measured points (mm)",
+    after_help = exit::EXIT_CODES
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -129,14 +146,19 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sim(args) => zeroset_sim::cli::run(&args),
         Command::Demo(args) => demo::run(&args),
         Command::Daemon(station) => station::daemon(&station),
-        Command::Teach(args) => station::run_job(&args.job, Request::Teach { part: args.part }),
-        Command::Inspect(args) => station::run_job(
-            &args.job,
-            Request::Inspect {
-                part: args.part,
-                serial: args.serial,
-            },
-        ),
+        Command::Teach(args) => {
+            station::run_job(&args.job, Request::Teach { part: args.part }).map(drop)
+        }
+        Command::Inspect(args) => {
+            let verdict = station::run_job(
+                &args.job,
+                Request::Inspect {
+                    part: args.part.clone(),
+                    serial: args.serial.clone(),
+                },
+            )?;
+            station::judge(&args.part, &args.serial, verdict)
+        }
         Command::Watch(args) => station::watch(&args),
         Command::Status(args) => station::status(&args),
         Command::Abort(station) => station::simple(&station, Request::Abort),

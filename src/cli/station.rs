@@ -7,8 +7,9 @@ use anyhow::Context;
 use clap::Args;
 
 use super::control::{accepted, Control};
+use super::exit::JobEnded;
 use super::watch::{JobEnd, Watch};
-use crate::api::{JobKind, JobPhase, Reply, Request, StationStatus};
+use crate::api::{JobKind, JobPhase, Reply, Request, StationStatus, Verdict};
 use crate::config::StationConfig;
 
 /// The station file, shared by every station command.
@@ -82,8 +83,8 @@ pub struct ReportArgs {
     /// The part type of the trend or the export (a part file's name).
     #[arg(long, default_value = "propeller")]
     pub part_type: String,
-    /// How many of the newest inspections the trend or the export covers.
-    #[arg(long, default_value_t = 50)]
+    /// How many of the newest inspections the trend or the export covers (at least 1).
+    #[arg(long, default_value_t = 50, value_parser = at_least_one)]
     pub last: usize,
     #[command(flatten)]
     pub station: StationFile,
@@ -92,6 +93,17 @@ pub struct ReportArgs {
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
 pub enum ExportFormat {
     Csv,
+}
+
+/// `--last`: a count of inspections, so 0 is a usage error rather than an empty history.
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(0) => Err("must be at least 1 (the number of newest inspections to cover)".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!(
+            "{e}; give a whole number of inspections, at least 1"
+        )),
+    }
 }
 
 /// The control socket of a station file.
@@ -149,8 +161,9 @@ fn init_logging(folder: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `zeroset teach` and `zeroset inspect`: starts the job and, unless detached, shows it live to its end.
-pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<()> {
+/// `zeroset teach` and `zeroset inspect`: starts the job and, unless detached, shows it live to its end. Returns
+/// the inspection's verdict (`None` for a teach or a detached job); an abort or a stop is [`JobEnded`].
+pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<Option<Verdict>> {
     // Subscribed before the job starts, so that none of its events are missed.
     let events = if job.detach {
         None
@@ -162,11 +175,27 @@ pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<()> {
         anyhow::bail!("unexpected reply from the daemon: {reply:?}");
     };
     let Some(events) = events else {
-        println!("job {} started; follow it with `zeroset watch`", info.id);
-        return Ok(());
+        outln!("job {} started; follow it with `zeroset watch`", info.id)?;
+        return Ok(None);
     };
-    let end = follow(events, Some(info.id), false, false)?;
+    let end = follow(events, Some(info.id), false, Following::ToItsStop)?;
     ended(end)
+}
+
+/// An inspection's verdict as the command's outcome: a failing part is [`JobEnded::PartFailed`] (exit code 4).
+pub fn judge(part: &str, serial: &str, verdict: Option<Verdict>) -> anyhow::Result<()> {
+    match verdict {
+        Some(Verdict::Fail {
+            points_outside,
+            worst_mm,
+        }) => Err(JobEnded::PartFailed(format!(
+            "part {part} serial {serial}: FAIL, {points_outside} {} outside the tolerance, worst {worst_mm:+.3} mm",
+            if points_outside == 1 { "point" } else { "points" }
+        ))
+        .into()),
+        Some(Verdict::Pass) => outln!("part {part} serial {serial}: PASS"),
+        None => Ok(()),
+    }
 }
 
 /// `zeroset watch`.
@@ -178,36 +207,75 @@ pub fn watch(args: &WatchArgs) -> anyhow::Result<()> {
     };
     let events = control.subscribe()?;
     if !args.events {
-        print_status(&status);
+        print_status(&status)?;
     }
     let job = status.job.filter(|j| !j.state.is_over()).map(|j| j.job.id);
-    follow(events, job, args.events, args.follow).map(drop)
+    if job.is_none() {
+        let waiting = "no job is running; waiting for the next one (Ctrl-C to stop)";
+        // With --events standard output holds event lines only.
+        if args.events {
+            eprintln!("{waiting}");
+        } else {
+            outln!("{waiting}")?;
+        }
+    }
+    let following = if args.follow {
+        Following::Forever
+    } else {
+        Following::ToItsEnd
+    };
+    follow(events, job, args.events, following).map(drop)
+}
+
+/// How long a command follows the daemon's events.
+#[derive(Clone, Copy, PartialEq)]
+enum Following {
+    /// Until the job ends or stops on a fault: teach and inspect, whose exit code tells a script how it went.
+    ToItsStop,
+    /// Until the job ends, through stops and resumes: an operator watching clears a stop and keeps watching.
+    ToItsEnd,
+    /// Job after job (`watch --follow`).
+    Forever,
 }
 
 fn follow(
     mut events: super::control::Events,
     job: Option<String>,
     raw: bool,
-    forever: bool,
+    following: Following,
 ) -> anyhow::Result<JobEnd> {
     let mut watch = Watch::new(job, raw);
     loop {
         let (event, line) = events.next()?;
         if raw {
-            print!("{line}");
+            out!("{line}")?;
         }
-        if let Some(end) = watch.show(&event) {
-            if !forever {
+        let end = match watch.show(&event)? {
+            Some(JobEnd::Stopped { .. }) if following != Following::ToItsStop => None,
+            end => end,
+        };
+        if let Some(end) = end {
+            if following != Following::Forever {
                 return Ok(end);
             }
         }
     }
 }
 
-fn ended(end: JobEnd) -> anyhow::Result<()> {
+fn ended(end: JobEnd) -> anyhow::Result<Option<Verdict>> {
     match end {
-        JobEnd::Finished { .. } => Ok(()),
-        JobEnd::Aborted => anyhow::bail!("the job was aborted"),
+        JobEnd::Finished { verdict } => Ok(verdict),
+        JobEnd::Aborted { job } => Err(JobEnded::Aborted(job).into()),
+        JobEnd::Stopped {
+            job,
+            reason,
+            next_step,
+        } => Err(JobEnded::Stopped {
+            job,
+            reason,
+            next_step,
+        }
+        .into()),
         JobEnd::Failed(error) => anyhow::bail!("the job failed: {error}"),
     }
 }
@@ -215,13 +283,9 @@ fn ended(end: JobEnd) -> anyhow::Result<()> {
 pub fn status(args: &StatusArgs) -> anyhow::Result<()> {
     match accepted(connect(&args.station)?.request(Request::Status)?)? {
         Reply::Status(status) if args.json => {
-            println!("{}", serde_json::to_string_pretty(&status)?);
-            Ok(())
+            outln!("{}", serde_json::to_string_pretty(&status)?)
         }
-        Reply::Status(status) => {
-            print_status(&status);
-            Ok(())
-        }
+        Reply::Status(status) => print_status(&status),
         other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
     }
 }
@@ -233,13 +297,13 @@ fn kind_name(kind: JobKind) -> &'static str {
     }
 }
 
-fn print_status(status: &StationStatus) {
-    println!("station {}", status.station);
+fn print_status(status: &StationStatus) -> anyhow::Result<()> {
+    outln!("station {}", status.station)?;
     for machine in &status.machines {
-        println!("  machine {}: {}", machine.name, machine.state);
+        outln!("  machine {}: {}", machine.name, machine.state)?;
     }
     if let Some(preparing) = &status.preparing {
-        println!(
+        outln!(
             "  setting up: {} {}{}",
             kind_name(preparing.kind),
             preparing.part,
@@ -247,7 +311,7 @@ fn print_status(status: &StationStatus) {
                 .serial
                 .as_ref()
                 .map_or(String::new(), |s| format!(" serial {s}"))
-        );
+        )?;
     }
     match &status.job {
         Some(job) => {
@@ -256,33 +320,30 @@ fn print_status(status: &StationStatus) {
                 JobPhase::Failed { .. } => "failed".to_string(),
                 other => other.to_string(),
             };
-            println!(
+            outln!(
                 "  job {} ({} {}): {phase}, {}/{} profiles done",
                 job.job.id,
                 kind_name(job.job.kind),
                 job.job.part,
                 job.profiles_done,
                 job.profiles_total
-            );
+            )?;
             match &job.state {
                 JobPhase::Stopped {
                     reason, next_step, ..
-                } => println!("  stopped: {reason}; {next_step}"),
-                JobPhase::Failed { error } => println!("  failed: {error}"),
-                _ => {}
+                } => outln!("  stopped: {reason}; {next_step}"),
+                JobPhase::Failed { error } => outln!("  failed: {error}"),
+                _ => Ok(()),
             }
         }
-        None => println!("  no job"),
+        None => outln!("  no job"),
     }
 }
 
 /// `zeroset abort` and `zeroset clear`: one request, its answer printed.
 pub fn simple(station: &StationFile, request: Request) -> anyhow::Result<()> {
     match accepted(connect(station)?.request(request)?)? {
-        Reply::Done { message } => {
-            println!("{message}");
-            Ok(())
-        }
+        Reply::Done { message } => outln!("{message}"),
         other => anyhow::bail!("unexpected reply from the daemon: {other:?}"),
     }
 }
@@ -296,14 +357,14 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
     };
     match accepted(connect(&args.station)?.request(request)?)? {
         Reply::Report { dir, summary } => {
-            println!("{summary}");
-            println!("report folder: {}", dir.display());
+            outln!("{summary}")?;
+            outln!("report folder: {}", dir.display())?;
             for file in [
                 crate::report::HTML_FILE,
                 crate::report::QIF_FILE,
                 crate::report::REPORT_FILE,
             ] {
-                println!("  {}", dir.join(file).display());
+                outln!("  {}", dir.join(file).display())?;
             }
             Ok(())
         }
@@ -324,8 +385,7 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
         args.part_type
     );
     if args.export.is_some() {
-        print!("{}", history_csv(&history));
-        return Ok(());
+        return out!("{}", history_csv(&history));
     }
     let newest = history.last().expect("not empty");
     let (lower, upper) = (newest.lower_mm, newest.upper_mm);
@@ -334,13 +394,20 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
         .map(|r| (&r.serial, &r.finished))
         .collect::<std::collections::BTreeSet<_>>()
         .len();
-    println!("{} trend: the last {parts} inspections", args.part_type);
+    outln!(
+        "{} trend: the last {parts} {}",
+        args.part_type,
+        if parts == 1 {
+            "inspection"
+        } else {
+            "inspections"
+        }
+    )?;
     let rows = trend(&history, lower, upper);
-    print!("{}", trend_text(&rows, lower, upper));
+    out!("{}", trend_text(&rows, lower, upper))?;
     let folder = config.folders.reports.join(&args.part_type);
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let chart = write_trend_html(&folder, &args.part_type, &rows, lower, upper)?;
-    println!("run charts: {}", chart.display());
-    Ok(())
+    outln!("run charts: {}", chart.display())
 }

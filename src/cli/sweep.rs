@@ -48,9 +48,11 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let config = StationConfig::load(&args.config)?;
     let sweep = sweep_plan(&config, &args.part).map_err(anyhow::Error::msg)?;
     let margin = config.safety.move_margin_mm;
-    println!(
-        "part {}: {} moves of its inspection checked against the taught model ({} triangles, chord tolerance {} mm), \
-         stylus ball {} mm, shank {} x {} mm, margin {margin} mm; distances in mm",
+    // The chord tolerance to the micrometre: the mesh's error is no finer than that.
+    outln!(
+        "part {}: {} moves of its inspection checked against the taught model ({} triangles, chord tolerance \
+         {:.3} mm); the stylus as the largest the station accepts: ball radius {} mm ([safety] max_ball_radius_mm), \
+         shank radius {} mm, length {} mm; margin {margin} mm; distances in mm",
         args.part,
         sweep.moves.len(),
         sweep.part.triangle_count(),
@@ -58,11 +60,16 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         sweep.stylus.ball_radius_mm,
         sweep.stylus.shank.radius_mm,
         sweep.stylus.shank.length_mm,
-    );
-    println!(
+    )?;
+    outln!(
         "{:>5}  {:<10} {:<8} {:<24} {:>10}  {:<6}  closest part point",
-        "move", "instance", "profile", "kind", "min mm", "by"
-    );
+        "move",
+        "instance",
+        "profile",
+        "kind",
+        "min mm",
+        "by"
+    )?;
     let mut rows = vec![
         "move,instance,profile,kind,min_distance_mm,stylus_part,x_mm,y_mm,z_mm,verdict".to_string(),
     ];
@@ -70,7 +77,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         let (instance, profile) = names(&sweep.plan, checked);
         let c = &checked.clearance;
         let verdict = verdict(checked, margin);
-        println!(
+        outln!(
             "{index:>5}  {instance:<10} {profile:<8} {:<24} {:>10.3}  {:<6}  ({:.3}, {:.3}, {:.3}) {verdict}",
             checked.planned.kind.describe(),
             c.min_distance_mm,
@@ -78,7 +85,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             c.at_point.x,
             c.at_point.y,
             c.at_point.z
-        );
+        )?;
         rows.push(format!(
             "{index},{instance},{profile},{},{:.6},{},{:.6},{:.6},{:.6},{verdict}",
             checked.planned.kind.describe(),
@@ -96,11 +103,11 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write {}", table.display()))?;
     let svg = args.out.join("silhouette.svg");
     let pieces = write_silhouette(&sweep, args.eye, &svg)?;
-    println!(
+    outln!(
         "wrote {} and {} ({pieces} silhouette components)",
         table.display(),
         svg.display()
-    );
+    )?;
     let refused = sweep
         .moves
         .iter()

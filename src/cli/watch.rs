@@ -7,13 +7,23 @@ use std::collections::HashMap;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::analysis::stats::{DeviationStats, RunningStats, Verdict};
-use crate::api::{Event, InstanceSummary, JobInfo, JobKind};
+use crate::api::{Event, InstanceSummary, JobInfo, JobKind, ScanRef};
 
-/// How a followed job ended.
+/// How a followed job ended, or stopped to wait for `zeroset clear`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum JobEnd {
-    Finished { passed: Option<bool> },
-    Aborted,
+    /// The verdict of an inspection (`None` for a teach).
+    Finished {
+        verdict: Option<Verdict>,
+    },
+    Aborted {
+        job: String,
+    },
+    Stopped {
+        job: String,
+        reason: String,
+        next_step: String,
+    },
     Failed(String),
 }
 
@@ -50,17 +60,18 @@ impl Watch {
         }
     }
 
-    /// Shows one event; returns how the job ended when this event ends it.
-    pub fn show(&mut self, event: &Event) -> Option<JobEnd> {
+    /// Shows one event; returns how the job ended (or stopped) when this event ends (or stops) it. Fails only when
+    /// standard output is closed.
+    pub fn show(&mut self, event: &Event) -> anyhow::Result<Option<JobEnd>> {
         if let Some(id) = event_job(event) {
             match &self.job {
-                Some(job) if job != id => return None,
+                Some(job) if job != id => return Ok(None),
                 None => self.job = Some(id.to_string()),
                 _ => {}
             }
         }
         match event {
-            Event::JobStarted { job, done } => self.lay_out(job, done.len()),
+            Event::JobStarted { job, done } => self.lay_out(job, done)?,
             Event::ScanStarted { machine, scan, .. } => {
                 if let Some(instance) = self.instances.get(&scan.instance) {
                     instance
@@ -110,12 +121,22 @@ impl Watch {
                 self.line(format!(
                     "{} {} done on {machine}, {points} points{stats} {verdict}",
                     scan.instance, scan.profile
-                ));
+                ))?;
             }
             Event::JobStopped {
-                reason, next_step, ..
-            } => self.line(format!("STOPPED: {reason}\n  next: {next_step}")),
-            Event::JobResumed { job } => self.line(format!("job {job} resumed")),
+                job,
+                reason,
+                next_step,
+                ..
+            } => {
+                self.line(format!("STOPPED: {reason}\n  next: {next_step}"))?;
+                return Ok(Some(JobEnd::Stopped {
+                    job: job.clone(),
+                    reason: reason.clone(),
+                    next_step: next_step.clone(),
+                }));
+            }
+            Event::JobResumed { job } => self.line(format!("job {job} resumed"))?,
             Event::ProfileRescanned {
                 machine,
                 scan,
@@ -124,18 +145,18 @@ impl Watch {
             } => self.line(format!(
                 "{} {} on {machine} scanned again: {reason}",
                 scan.instance, scan.profile
-            )),
+            ))?,
             Event::ReferenceSaved { path, profiles, .. } => {
                 self.finish_bars();
-                self.line(format!("reference saved: {}", path.display()));
+                self.line(format!("reference saved: {}", path.display()))?;
                 for fit in profiles {
                     let distance = match (fit.rms_mm, fit.max_mm) {
                         (Some(rms), Some(max)) => format!("fit RMS {rms:.4} mm, max {max:.4} mm"),
                         _ => "no fit distances kept by this reference kind".to_string(),
                     };
-                    self.line(format!("  {}: {} points, {distance}", fit.profile, fit.points));
+                    self.line(format!("  {}: {} points, {distance}", fit.profile, fit.points))?;
                 }
-                return Some(JobEnd::Finished { passed: None });
+                return Ok(Some(JobEnd::Finished { verdict: None }));
             }
             Event::JobFinished {
                 report,
@@ -144,34 +165,35 @@ impl Watch {
                 ..
             } => {
                 self.finish_bars();
-                self.line(instance_table(instances));
+                self.line(instance_table(instances))?;
                 if let Some(report) = report {
-                    self.line(format!("report: {}", report.display()));
+                    self.line(format!("report: {}", report.display()))?;
                     let html = report.join(crate::report::HTML_FILE);
-                    self.line(format!("open in a browser: {}", html.display()));
+                    self.line(format!("open in a browser: {}", html.display()))?;
                 }
-                return Some(JobEnd::Finished {
-                    passed: verdict.as_ref().map(Verdict::passed),
-                });
+                return Ok(Some(JobEnd::Finished {
+                    verdict: verdict.clone(),
+                }));
             }
             Event::JobAborted { job } => {
                 self.finish_bars();
-                self.line(format!("job {job} aborted"));
-                return Some(JobEnd::Aborted);
+                self.line(format!("job {job} aborted"))?;
+                return Ok(Some(JobEnd::Aborted { job: job.clone() }));
             }
             Event::JobFailed { error, .. } => {
                 self.finish_bars();
-                self.line(format!("FAILED: {error}"));
-                return Some(JobEnd::Failed(error.clone()));
+                self.line(format!("FAILED: {error}"))?;
+                return Ok(Some(JobEnd::Failed(error.clone())));
             }
             Event::Lagged { missed } => self.line(format!(
                 "(this display fell behind and missed {missed} events; the daemon and its report missed none)"
-            )),
+            ))?,
         }
-        None
+        Ok(None)
     }
 
-    fn lay_out(&mut self, job: &JobInfo, done: usize) {
+    /// A bar per instance, each already advanced by its profiles in `done` (on disk before a resume).
+    fn lay_out(&mut self, job: &JobInfo, done: &[ScanRef]) -> anyhow::Result<()> {
         self.finish_bars();
         self.profiles = job.profiles.len();
         let what = match job.kind {
@@ -183,15 +205,19 @@ impl Watch {
             ),
         };
         self.line(format!(
-            "job {} ({what}): {} instances x {} profiles on {}; deviations in mm, tolerance {:+.3} .. {:+.3} mm{}",
+            "job {} ({what}): {} x {} on {}; deviations in mm, tolerance {:+.3} .. {:+.3} mm{}",
             job.id,
-            job.instances.len(),
-            job.profiles.len(),
+            counted(job.instances.len(), "instance"),
+            counted(job.profiles.len(), "profile"),
             job.machines.join(", "),
             job.tolerance_mm[0],
             job.tolerance_mm[1],
-            if done > 0 { format!(", {done} profiles already done") } else { String::new() }
-        ));
+            if done.is_empty() {
+                String::new()
+            } else {
+                format!(", {} already done", counted(done.len(), "profile"))
+            }
+        ))?;
         let style =
             ProgressStyle::with_template("{prefix:>10} [{bar:20}] {pos}/{len} profiles {msg}")
                 .expect("a valid template")
@@ -209,6 +235,12 @@ impl Watch {
                 },
             );
         }
+        for scan in done {
+            if let Some(instance) = self.instances.get(&scan.instance) {
+                instance.bar.inc(1);
+            }
+        }
+        Ok(())
     }
 
     fn finish_bars(&mut self) {
@@ -217,16 +249,23 @@ impl Watch {
         }
     }
 
-    fn line(&self, text: String) {
+    fn line(&self, text: String) -> anyhow::Result<()> {
         if self.quiet {
-            return;
+            return Ok(());
         }
         if self.bars.is_hidden() {
-            println!("{text}");
+            outln!("{text}")
         } else {
+            // Above the bars on the terminal (standard error); a terminal that went away ends nothing here.
             let _ = self.bars.println(text);
+            Ok(())
         }
     }
+}
+
+/// "1 instance", "3 instances".
+fn counted(count: usize, noun: &str) -> String {
+    format!("{count} {noun}{}", if count == 1 { "" } else { "s" })
 }
 
 fn console_is_terminal() -> bool {
@@ -289,4 +328,90 @@ pub fn instance_table(instances: &[InstanceSummary]) -> String {
     }
     table.pop();
     table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scan(instance: &str, profile: &str) -> ScanRef {
+        ScanRef {
+            instance: instance.into(),
+            profile: profile.into(),
+        }
+    }
+
+    fn bar_positions(watch: &Watch) -> Vec<(String, u64)> {
+        let mut positions: Vec<_> = watch
+            .instances
+            .iter()
+            .map(|(name, i)| (name.clone(), i.bar.position()))
+            .collect();
+        positions.sort();
+        positions
+    }
+
+    #[test]
+    fn a_resumed_job_s_bars_count_the_profiles_done_before_the_stop() {
+        let job = JobInfo {
+            id: "j".into(),
+            kind: JobKind::Inspect,
+            part: "propeller".into(),
+            serial: Some("SN-1".into()),
+            instances: vec!["A".into(), "B".into(), "C".into()],
+            profiles: vec!["r100".into(), "r200".into(), "r300".into()],
+            machines: vec!["cmm1".into()],
+            tolerance_mm: [-0.1, 0.1],
+        };
+        let mut watch = Watch::new(None, true);
+        let started = Event::JobStarted {
+            job,
+            done: vec![scan("A", "r100"), scan("A", "r200"), scan("B", "r100")],
+        };
+        assert_eq!(watch.show(&started).unwrap(), None);
+        let expected = |a, b, c| {
+            vec![
+                ("A".to_string(), a),
+                ("B".to_string(), b),
+                ("C".to_string(), c),
+            ]
+        };
+        assert_eq!(bar_positions(&watch), expected(2, 1, 0));
+        let done = Event::ProfileDone {
+            job: "j".into(),
+            machine: "cmm1".into(),
+            scan: scan("A", "r300"),
+            points: 10,
+            stats: None,
+            verdict: None,
+            at_unix_ms: 0,
+        };
+        watch.show(&done).unwrap();
+        assert_eq!(bar_positions(&watch), expected(3, 1, 0));
+    }
+
+    #[test]
+    fn a_stop_is_reported_as_such_and_counts_read_in_the_singular() {
+        let mut watch = Watch::new(Some("j".into()), true);
+        let stopped = Event::JobStopped {
+            job: "j".into(),
+            machine: Some("cmm1".into()),
+            scan: None,
+            reason: "emergency stop".into(),
+            next_step: "run `zeroset clear`".into(),
+        };
+        assert_eq!(
+            watch.show(&stopped).unwrap(),
+            Some(JobEnd::Stopped {
+                job: "j".into(),
+                reason: "emergency stop".into(),
+                next_step: "run `zeroset clear`".into(),
+            })
+        );
+        // Another job's events are not this watch's.
+        let other = Event::JobAborted { job: "k".into() };
+        assert_eq!(watch.show(&other).unwrap(), None);
+        assert_eq!(counted(1, "instance"), "1 instance");
+        assert_eq!(counted(3, "profile"), "3 profiles");
+    }
 }

@@ -92,7 +92,14 @@ pub struct ToleranceEntry {
 impl PartConfig {
     /// Reads and checks the file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        Self::from_text(&read_text(path)?, path)
+        let config = Self::from_text(&read_text(path)?, path)?;
+        config
+            .check_file_name(path)
+            .map_err(|problem| ConfigError::Invalid {
+                path: path.to_owned(),
+                problem,
+            })?;
+        Ok(config)
     }
 
     /// Parses and checks the text of the file at `path` (which errors name).
@@ -103,6 +110,20 @@ impl PartConfig {
             problem,
         })?;
         Ok(config)
+    }
+
+    /// The station finds a part by its file's name and names its references, reports and history by `name`: two
+    /// names for one part would file its results under a name the operator never asked for.
+    fn check_file_name(&self, path: &Path) -> Result<(), String> {
+        let stem = path.file_stem().map(|s| s.to_string_lossy());
+        match stem {
+            Some(stem) if stem != self.name => Err(format!(
+                "name = {:?} but the file is named {stem}.toml; the station asks for a part by its file's name, \
+                 so make them the same (rename the file to {}.toml or set name = {stem:?})",
+                self.name, self.name
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// What serde cannot check: references between keys, order, ranges and directions.
@@ -441,6 +462,22 @@ mod tests {
         std::fs::write(&path, text.replace("kind = \"ip\"", "kind = \"gear\"")).unwrap();
         let message = PartConfig::load(&path).unwrap_err().to_string();
         assert!(message.contains("unknown variant `gear`"), "{message}");
+    }
+
+    #[test]
+    fn a_name_other_than_the_file_s_is_refused_naming_both() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("blade.toml");
+        std::fs::copy(repo("config/parts/propeller.toml"), &path).unwrap();
+        let message = PartConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.starts_with(&path.display().to_string())
+                && message.contains("name = \"propeller\" but the file is named blade.toml"),
+            "{message}"
+        );
+        let renamed = dir.path().join("propeller.toml");
+        std::fs::rename(&path, &renamed).unwrap();
+        assert_eq!(PartConfig::load(&renamed).unwrap().name, "propeller");
     }
 
     #[test]

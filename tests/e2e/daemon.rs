@@ -179,6 +179,33 @@ impl Station {
         run.stdout
     }
 
+    /// Runs an inspection to its end, whatever the part's verdict: exit code 0 (within tolerance) or 4 (outside:
+    /// the simulated propeller's blades B and C are); what it printed.
+    pub fn inspected(&self, args: &[&str]) -> String {
+        let run = self.cli(args);
+        assert!(
+            matches!(run.code, Some(0 | 4)),
+            "zeroset {args:?} exited {:?}:\n{}\n{}",
+            run.code,
+            run.stdout,
+            run.stderr
+        );
+        run.stdout
+    }
+
+    /// `zeroset ARGS --config STATION` in the background, its standard output and error piped.
+    pub fn spawn(&self, args: &[&str]) -> Child {
+        Command::new(env!("CARGO_BIN_EXE_zeroset"))
+            .args(args)
+            .arg("--config")
+            .arg(&self.station_file)
+            .current_dir(repo())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("zeroset starts")
+    }
+
     /// `zeroset watch --events --follow` in the background; its events arrive on the receiver.
     pub fn watch(&self) -> Watcher {
         let mut child = Command::new(env!("CARGO_BIN_EXE_zeroset"))

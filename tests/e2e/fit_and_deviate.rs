@@ -154,7 +154,7 @@ fn a_stack_of_five_profiles_measures_blade_b_below_blade_a() {
 
 /// Points on the ellipsoid x^2/40^2 + y^2/30^2 + z^2/20^2 = 1 (mm), moved `offset` mm along the outward normal,
 /// as an x,y,z point file.
-fn ellipsoid_csv(path: &std::path::Path, count: usize, offset: f64) {
+pub fn ellipsoid_csv(path: &std::path::Path, count: usize, offset: f64) {
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     let mut text = String::from("x,y,z\n");
     for i in 0..count {

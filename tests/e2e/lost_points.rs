@@ -11,7 +11,7 @@ use crate::station::{assert_no_repeated_points, point_counts};
 #[test]
 fn a_scan_that_lost_a_line_of_points_is_scanned_again_to_its_full_count() {
     let mut station = station();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
     let (_, whole) = station.report("SN-WHOLE");
     // Lines lost early, midway and late in a profile's scan, in different profiles.
     for (serial, at) in [("SN-D1", 25), ("SN-D2", 120), ("SN-D3", 300)] {
@@ -107,7 +107,7 @@ fn a_report_that_cannot_be_written_waits_for_the_fix_and_is_written_from_the_sca
 #[test]
 fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_other() {
     let mut station = station();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
     let (_, whole) = station.report("SN-WHOLE");
     let mut watcher = station.watch();
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-T", "--detach"]);
@@ -162,7 +162,7 @@ fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_oth
 #[test]
 fn a_lost_line_then_clear_reconnects_and_the_job_continues_whole() {
     let mut station = station();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
     let (_, whole) = station.report("SN-WHOLE");
     let mut watcher = station.watch();
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-LINK", "--detach"]);

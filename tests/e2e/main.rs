@@ -11,6 +11,7 @@ mod lost_points;
 mod machine_link;
 mod machine_state;
 mod nut;
+mod operator;
 mod readme;
 mod responsive;
 mod sim;

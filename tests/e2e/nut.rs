@@ -74,6 +74,18 @@ fn a_nut_taught_as_a_supershape_measures_the_next_nut_of_the_batch() {
     // The inspection's moves against the taught nut: descent, contact scan, lift-off and way out per profile.
     let sweep = master.root.path().join("sweep");
     let out = master.cli_ok(&["sweep", "nut", "--out", &sweep.display().to_string()]);
+    // The header states the chord tolerance to the micrometre and the stylus's ball as a radius.
+    let header = out.lines().next().unwrap();
+    let chord = header
+        .split("chord tolerance ")
+        .nth(1)
+        .and_then(|t| t.split(" mm").next())
+        .unwrap_or_else(|| panic!("{header}"));
+    assert!(
+        chord.split('.').nth(1).is_some_and(|d| d.len() == 3),
+        "{header}"
+    );
+    assert!(header.contains("ball radius 1.5 mm"), "{header}");
     let rows: Vec<&str> = out.lines().filter(|l| l.ends_with(" ok")).collect();
     assert!(rows.len() >= 12 && !out.contains("REFUSED"), "{out}");
     assert!(
@@ -112,7 +124,7 @@ fn a_nut_taught_as_a_supershape_measures_the_next_nut_of_the_batch() {
     let batch = Station::start_as("nut-b.toml", "station-nut.toml");
     std::fs::create_dir_all(batch.data().join("references")).expect("a references folder");
     std::fs::copy(master.reference_of("nut"), batch.reference_of("nut")).expect("copied");
-    let out = batch.cli_ok(&["inspect", "nut", "--serial", "NUT-2"]);
+    let out = batch.inspected(&["inspect", "nut", "--serial", "NUT-2"]);
     assert!(out.contains("PASS"), "{out}");
     let (dir, report) = batch.report_of("nut", "NUT-2");
     assert!(

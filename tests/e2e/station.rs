@@ -155,7 +155,7 @@ pub fn assert_no_repeated_points(report: &PartReport) {
 fn teach_and_inspect_measure_the_simulated_blade_errors() {
     let station = Station::start("propeller.toml");
     teach(&station);
-    let out = station.cli_ok(&["inspect", "propeller", "--serial", "SN-1"]);
+    let out = station.inspected(&["inspect", "propeller", "--serial", "SN-1"]);
     assert!(out.contains("report: "), "{out}");
     for blade in ["A", "B", "C"] {
         assert!(
@@ -281,7 +281,7 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
 fn two_machines_scan_profiles_at_the_same_time() {
     let station = Station::start("two-machines.toml").with_taught_reference();
     let mut watcher = station.watch();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-2"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-2"]);
     watcher.until(30, |e| matches!(e, Event::JobFinished { .. }));
     // Each machine's scans as (start, end) times, from the events.
     let mut started: BTreeMap<(String, String, String), u64> = BTreeMap::new();
@@ -331,7 +331,7 @@ fn two_machines_scan_profiles_at_the_same_time() {
 fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_point() {
     let mut station = Station::start("propeller.toml").with_taught_reference();
     // The same part inspected without a fault: the point count of every profile to expect.
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
     let (_, clean) = station.report("SN-CLEAN");
 
     let mut watcher = station.watch();
@@ -407,7 +407,7 @@ fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_
 #[test]
 fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
     let mut station = Station::start("propeller.toml").with_taught_reference();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-CLEAN"]);
     let (_, clean) = station.report("SN-CLEAN");
 
     let mut watcher = station.watch();
@@ -486,7 +486,7 @@ fn an_abort_stops_the_job_and_after_clear_the_station_takes_the_next() {
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("machines clear"), "{cleared}");
     // Cleared and clear of the part: the next job runs to its end.
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-7"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-7"]);
     let (_, report) = station.report("SN-7");
     assert_eq!(report.instances.len(), 3);
 }

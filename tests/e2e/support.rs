@@ -11,9 +11,11 @@ pub fn config(relative: &str) -> String {
     repo().join("config").join(relative).display().to_string()
 }
 
-/// What a run of the binary printed, and whether it succeeded.
+/// What a run of the binary printed, and how it exited.
 pub struct Run {
     pub success: bool,
+    /// The exit code (`None` when killed by a signal).
+    pub code: Option<i32>,
     pub stdout: String,
     pub stderr: String,
 }
@@ -26,6 +28,7 @@ pub fn zeroset(args: &[&str]) -> Run {
         .expect("the zeroset binary runs");
     Run {
         success: output.status.success(),
+        code: output.status.code(),
         stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
     }
