@@ -339,6 +339,6 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let chart = write_trend_html(&folder, &args.part_type, &rows, lower, upper)?;
-    println!("run charts: {}", chart.display());
+    println!("trend report, open in a browser: {}", chart.display());
     Ok(())
 }
