@@ -409,5 +409,5 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
     let chart = write_trend_html(&folder, &args.part_type, &rows, lower, upper)?;
-    outln!("run charts: {}", chart.display())
+    outln!("trend report, open in a browser: {}", chart.display())
 }

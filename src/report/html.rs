@@ -12,7 +12,7 @@ use crate::fsutil::write_atomically;
 
 pub const HTML_FILE: &str = "report.html";
 
-const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;color:#222}\
+pub(super) const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;color:#222}\
 table{border-collapse:collapse;margin:0.5em 0 1.5em}\
 th,td{border:1px solid #bbb;padding:0.2em 0.6em;text-align:right}\
 th{background:#eee}td.name{text-align:left}\

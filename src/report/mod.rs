@@ -4,12 +4,14 @@
 
 mod export;
 mod html;
+mod individuals;
 mod plots;
 mod qif;
 mod store;
 mod summary;
 mod trend;
 mod trend_chart;
+mod trend_html;
 mod writers;
 
 use std::path::Path;
@@ -23,7 +25,7 @@ pub use qif::{write_qif, QIF_FILE};
 pub use store::{ProfileRecord, Store, StoreError, STORE_FILE};
 pub use summary::summary_text;
 pub use trend::{trend, trend_text, TrendRow};
-pub use trend_chart::{write_trend_html, TREND_FILE};
+pub use trend_html::{write_trend_html, TREND_FILE};
 pub use writers::{write_report, DEVIATIONS_FILE, REPORT_FILE, SUMMARY_FILE};
 
 pub const FORMAT: &str = "zeroset-report";

@@ -92,12 +92,12 @@ fn assert_qif_valid(file: &std::path::Path) {
     );
 }
 
-/// Renders a report page with headless Chromium to PNG, and checks that the browser's page has two plots (the
-/// deviations and the whiskers) per profile. Skipped, saying so, where Chromium is not installed.
-fn render_in_a_browser(page: &std::path::Path, profiles: usize) {
+/// Renders a report page with headless Chromium to a PNG screenshot (which must show something), and returns the
+/// page as the browser built it; `None`, saying so, where Chromium is not installed.
+fn render_in_a_browser(page: &std::path::Path) -> Option<String> {
     let Ok(browser) = which("chromium") else {
         eprintln!("skipped: chromium is not installed (.ci/run installs Debian's chromium)");
-        return;
+        return None;
     };
     let url = format!("file://{}", page.display());
     let png = page.with_extension("png");
@@ -119,12 +119,7 @@ fn render_in_a_browser(page: &std::path::Path, profiles: usize) {
         .args(["--dump-dom", &url])
         .output()
         .expect("chromium runs");
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    assert_eq!(
-        dom.matches("<svg").count(),
-        2 * profiles,
-        "plots in the rendered page"
-    );
+    Some(String::from_utf8_lossy(&dom.stdout).into_owned())
 }
 
 /// The path of an installed program.
@@ -181,7 +176,13 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         "{out}"
     );
     assert_qif_valid(&dir.join("report.qif"));
-    render_in_a_browser(&dir.join("report.html"), 5);
+    if let Some(dom) = render_in_a_browser(&dir.join("report.html")) {
+        assert_eq!(
+            dom.matches("<svg").count(),
+            2 * 5,
+            "a deviation and a whisker plot per profile in the rendered page"
+        );
+    }
     // The same numbers in every report of the inspection.
     let b300 = &report.instances[1].profiles[2];
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
@@ -250,31 +251,122 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         summary.contains("mm") && summary.contains(&dir.display().to_string()),
         "{summary}"
     );
-    // The history holds the same numbers, and trends over them (one part: no spread yet, and a warning).
+    // The history holds the same numbers, and trends over their extremes (one part: no spread yet, no Cp or
+    // Cpk, and a warning).
     let trend = station.cli_ok(&["report", "--trend"]);
     let b300 = &report.instances[1].profiles[2];
     let row = trend
         .lines()
         .find(|l| l.starts_with("B ") && l.contains(" r300 "))
         .unwrap_or_else(|| panic!("{trend}"));
-    assert!(
-        row.contains(&format!("{:+.4}", b300.stats.mean_mm)),
-        "{row} vs {:?}",
-        b300.stats
-    );
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    assert_eq!(cells[2..4], ["1", "1"], "one part, failed: {row}");
+    assert_eq!(cells[4], format!("{:+.4}", b300.stats.max_mm), "{row}");
+    assert_eq!(cells[6], format!("{:+.4}", b300.stats.min_mm), "{row}");
+    assert_eq!(cells[10..12], ["-", "-"], "no Cp, Cpk of one part: {row}");
     assert!(trend.contains("warning: 1 parts"), "{trend}");
-    let chart = trend
-        .lines()
-        .find_map(|l| l.strip_prefix("run charts: "))
-        .unwrap_or_else(|| panic!("{trend}"));
+    let chart = trend_page(&trend);
     let chart = std::fs::read_to_string(chart).expect("trend.html");
     assert_eq!(
         chart.matches("<svg").count(),
         15,
-        "a run chart per profile of each blade"
+        "a trend chart per profile of each blade"
     );
     let csv = station.cli_ok(&["report", "--export", "csv"]);
     assert_eq!(csv.lines().count(), 1 + 15, "{csv}");
+}
+
+/// The trend page `zeroset report --trend` wrote, from what it printed.
+fn trend_page(printed: &str) -> std::path::PathBuf {
+    printed
+        .lines()
+        .find_map(|l| l.strip_prefix("trend report, open in a browser: "))
+        .unwrap_or_else(|| panic!("{printed}"))
+        .into()
+}
+
+#[test]
+fn the_trend_of_a_failing_blade_is_not_capable_and_renders_in_a_browser() {
+    let station = Station::start("propeller.toml").with_taught_reference();
+    let serials = ["SN-T1", "SN-T2", "SN-T3"];
+    for serial in serials {
+        let run = station.cli(&["inspect", "propeller", "--serial", serial]);
+        assert_eq!(
+            run.code,
+            Some(4),
+            "the part fails: {}{}",
+            run.stdout,
+            run.stderr
+        );
+    }
+    let (_, report) = station.report("SN-T3");
+    let b100 = &report.instances[1].profiles[0];
+    assert!(
+        !b100.verdict.passed(),
+        "blade B r100 fails: {:?}",
+        b100.stats
+    );
+    let trend = station.cli_ok(&["report", "--trend"]);
+    let row = trend
+        .lines()
+        .find(|l| l.starts_with("B ") && l.contains(" r100 "))
+        .unwrap_or_else(|| panic!("{trend}"));
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    assert_eq!(cells[2..4], ["3", "3"], "three parts, all failed: {row}");
+    let cp: f64 = cells[10].parse().unwrap_or_else(|_| panic!("{row}"));
+    let cpk: f64 = cells[11].parse().unwrap_or_else(|_| panic!("{row}"));
+    assert!(
+        cp < 1.0 && cpk < 1.0,
+        "Cp {cp}, Cpk {cpk} of a failing profile: {row}"
+    );
+    let page = trend_page(&trend);
+    let html = std::fs::read_to_string(&page).expect("trend.html");
+    assert!(!html.contains("<pre"), "no preformatted dump");
+    assert!(
+        html.contains(&format!("{:+.4}", b100.stats.max_mm)),
+        "SN-T3's worst + of B r100 in a table"
+    );
+    let Some(dom) = render_in_a_browser(&page) else {
+        return;
+    };
+    // As the browser built it: the profile table and one parts table per profile; a chart per profile, each
+    // with every part's serial and date on its abscissa, control limits, and red marks outside the band.
+    assert_eq!(dom.matches("<table>").count(), 1 + 15, "tables");
+    assert_eq!(dom.matches("<svg").count(), 15, "charts");
+    let b100_chart = dom
+        .split("<h2>")
+        .find(|s| s.starts_with("Instance B, profile r100"))
+        .expect("B r100's section");
+    for serial in serials {
+        assert!(
+            b100_chart.contains(&format!(">\n{serial}  20")),
+            "{serial} on B r100's abscissa"
+        );
+    }
+    let newest = format!("SN-T3  {}", report.finished[..16].replacen('T', " ", 1));
+    assert!(
+        b100_chart.contains(&newest),
+        "{newest}: the newest part's serial and date"
+    );
+    for colour in ["#D55E00", "#0072B2"] {
+        assert!(
+            b100_chart.matches(&format!("stroke=\"{colour}\"")).count() > 20,
+            "each extreme's control limits, dashed in its colour ({colour})"
+        );
+    }
+    assert_eq!(
+        b100_chart.matches("fill=\"#C8001E\"").count(),
+        2 * 3 + 1,
+        "both extremes of each part of B r100 outside the band marked red (and the legend's sample)"
+    );
+    let b100_row = dom
+        .split("<tr>")
+        .find(|r| r.starts_with("<td class=\"name\">B</td><td class=\"name\">r100</td>"))
+        .expect("B r100's row in the profile table");
+    assert!(
+        b100_row.matches("class=\"fail\"").count() >= 3,
+        "failed parts, Cp and Cpk marked: {b100_row}"
+    );
 }
 
 #[test]
