@@ -11,13 +11,23 @@
 //! - orthogonal-distance refinement: Levenberg-Marquardt (Gauss-Newton with damping) on the exact distances of the
 //!   points to the zero set, started from the ridge answer, with the same regulariser.
 //!
-//! Every system is solved by Householder QR of the stacked matrix, never by normal equations. The data are
-//! normalised first (centroid, unit RMS radius) and the normalisation is stored with the model.
+//! Every system is solved by Householder QR of the stacked rows (chunk by chunk, see `lsq`), never by normal
+//! equations. The data are normalised first (centroid, unit RMS radius) and the normalisation is stored with the
+//! model. The candidates of one fit share what does not depend on the offset: the point index, the reduced data
+//! rows, the ridge weights and the side probes.
 
-use nalgebra::{DMatrix, DVector, SVector};
+mod design;
+mod lsq;
+mod offsets;
+
+use nalgebra::{DVector, SVector};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::distance::{crosses_zero_set, lagrange_newton, ExactDistance};
+use self::design::Monomials;
+use self::lsq::Reduced;
+use self::offsets::{choose_offsets, Offsets};
+use super::distance::{crosses_zero_set, lagrange_newton, ExactDistance, Foot};
 use super::implicit::{Frame, IpModel};
 use super::nearest::PointIndex;
 use super::poly::{factorial, Basis, Poly, MAX_DEGREE};
@@ -36,9 +46,9 @@ const ORTHOGONAL_START_OFFSETS: [f64; 2] = [0.1, 0.03];
 /// probe noise of a CMM (microns) stays well below it on parts of tens of millimetres.
 const PROBE_REACH: f64 = 0.1;
 const PROBE_MIN_DEPTH: f64 = 2e-3;
-/// An offset point must be at least this fraction of its offset away from every other data point.
-const OFFSET_CLEARANCE: f64 = 0.98;
-const OFFSET_HALVINGS: usize = 12;
+/// The exact distances of the statistics follow the scan in runs of this many points, the runs in parallel (each
+/// run's first point is found by the seeded search, the others from their predecessor's foot).
+const MEASURE_RUN: usize = 4096;
 const ODR_MAX_ITERATIONS: usize = 60;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -198,27 +208,46 @@ pub fn fit_ip<const N: usize>(
         (None, FitMethod::Orthogonal) => ORTHOGONAL_START_OFFSETS.to_vec(),
         (None, FitMethod::ThreeL | FitMethod::Ridge) => OFFSET_CANDIDATES.to_vec(),
     };
-    let probes = SideProbes::new(&unit, normals);
+    let index = PointIndex::new(&unit);
+    let mut offset_sets = OffsetSets::default();
+    let probes = SideProbes::new(
+        &unit,
+        normals,
+        offset_sets.get(&index, &unit, normals, PROBE_REACH),
+    );
+    let monomials = Monomials::new(&basis);
+    let data_rows = Reduced::of_rows(unit.len(), 1, basis.len(), |i, rows| {
+        monomials.fill(&unit[i], rows.push(0.0))
+    });
+    let ridge = match options.method {
+        FitMethod::ThreeL => None,
+        FitMethod::Ridge | FitMethod::Orthogonal => Some(
+            ridge_weights(&basis, &unit, options.ridge)
+                .iter()
+                .map(|w| w.sqrt())
+                .collect::<Vec<f64>>(),
+        ),
+    };
     let mut best: Option<Fitted<N>> = None;
     for largest_offset in candidates {
-        let offsets = choose_offsets(&unit, normals, largest_offset);
-        let ridge = match options.method {
-            FitMethod::ThreeL => None,
-            FitMethod::Ridge | FitMethod::Orthogonal => {
-                Some(ridge_weights(&basis, &unit, options.ridge))
-            }
-        };
-        let (coeffs, condition_number) =
-            solve_three_level(&basis, &unit, normals, &offsets, ridge.as_deref())?;
+        let offsets = offset_sets.get(&index, &unit, normals, largest_offset);
+        let (coeffs, condition_number) = solve_three_level(
+            &monomials,
+            &data_rows,
+            &unit,
+            normals,
+            offsets,
+            ridge.as_deref(),
+        )?;
         let mut poly = Poly::new(degree, coeffs);
         let mut refinement_iterations = 0;
         if options.method == FitMethod::Orthogonal {
             // Unconstrained first: the most accurate, unless its zero set crosses more side segments again than
             // its start's does; then the refinement that may not.
             let allowed = probes.crossed_again(&poly);
-            let refined = refine_orthogonal(&poly, &unit, None)
+            let refined = refine_orthogonal(&poly, &monomials, &unit, None)
                 .filter(|(r, _)| probes.crossed_again(r) <= allowed)
-                .or_else(|| refine_orthogonal(&poly, &unit, Some(&probes)));
+                .or_else(|| refine_orthogonal(&poly, &monomials, &unit, Some(&probes)));
             if let Some((refined, iterations)) = refined {
                 poly = refined;
                 refinement_iterations = iterations;
@@ -289,37 +318,31 @@ fn check_spread<const N: usize>(points: &[SVector<f64, N>]) -> Result<(), FitErr
     Ok(())
 }
 
-/// The 3L offsets of one point, in normalised units; `None` where no safe offset exists on that side.
-#[derive(Debug, Clone, Copy)]
-struct Offsets {
-    inside: Option<f64>,
-    outside: Option<f64>,
+/// The offsets of each largest offset tried, computed once per fit (the side probes reach as far as the largest
+/// candidate).
+#[derive(Default)]
+struct OffsetSets {
+    sets: Vec<(f64, Vec<Offsets>)>,
 }
 
-fn choose_offsets<const N: usize>(
-    unit: &[SVector<f64, N>],
-    normals: &[SVector<f64, N>],
-    largest: f64,
-) -> Vec<Offsets> {
-    let index = PointIndex::new(unit);
-    let safe = |i: usize, direction: f64| -> Option<f64> {
-        let mut c = largest;
-        for _ in 0..OFFSET_HALVINGS {
-            let offset_point = unit[i] + normals[i] * (direction * c);
-            let nearest = index.nearest(&offset_point)?;
-            if nearest == i || (offset_point - unit[nearest]).norm() >= OFFSET_CLEARANCE * c {
-                return Some(c);
+impl OffsetSets {
+    fn get<const N: usize>(
+        &mut self,
+        index: &PointIndex<N>,
+        unit: &[SVector<f64, N>],
+        normals: &[SVector<f64, N>],
+        largest: f64,
+    ) -> &[Offsets] {
+        let at = match self.sets.iter().position(|(l, _)| *l == largest) {
+            Some(at) => at,
+            None => {
+                let offsets = choose_offsets(index, unit, normals, largest);
+                self.sets.push((largest, offsets));
+                self.sets.len() - 1
             }
-            c /= 2.0;
-        }
-        None
-    };
-    (0..unit.len())
-        .map(|i| Offsets {
-            inside: safe(i, -1.0),
-            outside: safe(i, 1.0),
-        })
-        .collect()
+        };
+        &self.sets[at].1
+    }
 }
 
 /// Segments across the data along each point's normal, from inside to outside, each end half-way to the medial
@@ -336,15 +359,15 @@ pub(crate) struct SideProbes<const N: usize> {
 const SIDE_SAMPLES: usize = 12;
 
 impl<const N: usize> SideProbes<N> {
-    fn new(unit: &[SVector<f64, N>], normals: &[SVector<f64, N>]) -> Self {
-        let offsets = choose_offsets(unit, normals, PROBE_REACH);
+    /// The segments, from the offsets whose largest is PROBE_REACH.
+    fn new(unit: &[SVector<f64, N>], normals: &[SVector<f64, N>], offsets: &[Offsets]) -> Self {
         // Segments shallower than this could be crossed twice through the probe noise alone.
         let deep_enough = |d: Option<f64>| d.filter(|d| *d >= PROBE_MIN_DEPTH);
         let segments = unit
             .iter()
             .zip(normals)
             .zip(offsets)
-            .filter_map(|((u, n), o)| {
+            .filter_map(|((u, n), &o)| {
                 let inside = deep_enough(o.inside)?;
                 let outside = deep_enough(o.outside)?;
                 Some((u - n * (0.5 * inside), u + n * (0.5 * outside)))
@@ -356,7 +379,7 @@ impl<const N: usize> SideProbes<N> {
     /// How many segments the polynomial's zero set (in normalised coordinates) crosses more than once.
     fn crossed_again(&self, poly: &Poly<N>) -> usize {
         self.segments
-            .iter()
+            .par_iter()
             .filter(|(inside, outside)| {
                 let mut previous = poly.value(inside);
                 let mut changes = 0;
@@ -406,55 +429,29 @@ fn ridge_weights<const N: usize>(
         .collect()
 }
 
-/// Builds and solves the (regularised) 3L system. Returns the coefficients and the condition number.
+/// Solves the (regularised) 3L system: the data rows (already reduced, target 0), for each point an offset row on
+/// each side where it has a safe offset (target -c inside, +c outside), and the ridge rows (`ridge`: the square
+/// roots of the weights). Returns the coefficients and the condition number.
 fn solve_three_level<const N: usize>(
-    basis: &Basis<N>,
+    monomials: &Monomials<N>,
+    data_rows: &Reduced,
     unit: &[SVector<f64, N>],
     normals: &[SVector<f64, N>],
     offsets: &[Offsets],
     ridge: Option<&[f64]>,
 ) -> Result<(Vec<f64>, f64), FitError> {
-    let mut rows: Vec<(SVector<f64, N>, f64)> = Vec::with_capacity(3 * unit.len());
-    for ((u, n), o) in unit.iter().zip(normals).zip(offsets) {
-        rows.push((*u, 0.0));
+    let offset_rows = Reduced::of_rows(unit.len(), 2, monomials.len(), |i, rows| {
+        let (u, n, o) = (&unit[i], &normals[i], &offsets[i]);
         if let Some(c) = o.inside {
-            rows.push((u - n * c, -c));
+            monomials.fill(&(u - n * c), rows.push(-c));
         }
         if let Some(c) = o.outside {
-            rows.push((u + n * c, c));
+            monomials.fill(&(u + n * c), rows.push(c));
         }
-    }
-    let m = basis.len();
-    let extra = if ridge.is_some() { m } else { 0 };
-    let mut a = DMatrix::<f64>::zeros(rows.len() + extra, m);
-    let mut b = DVector::<f64>::zeros(rows.len() + extra);
-    let mut row = vec![0.0; m];
-    for (i, (u, target)) in rows.iter().enumerate() {
-        basis.monomials_into(u, &mut row);
-        a.row_mut(i).copy_from_slice(&row);
-        b[i] = *target;
-    }
-    if let Some(weights) = ridge {
-        for (j, w) in weights.iter().enumerate() {
-            a[(rows.len() + j, j)] = w.sqrt();
-        }
-    }
-    least_squares(a, b).ok_or(FitError::Singular)
-}
-
-/// Solves min |A x - b| by Householder QR. Returns x and the condition number of A.
-fn least_squares(a: DMatrix<f64>, mut b: DVector<f64>) -> Option<(Vec<f64>, f64)> {
-    let m = a.ncols();
-    let qr = a.qr();
-    qr.q_tr_mul(&mut b);
-    let r = qr.r();
-    let singular = r.clone().singular_values();
-    let (largest, smallest) = (singular.max(), singular.min());
-    if smallest <= largest * 1e-15 || !largest.is_finite() {
-        return None;
-    }
-    let x = r.solve_upper_triangular(&b.rows(0, m))?;
-    Some((x.iter().copied().collect(), largest / smallest))
+    });
+    Reduced::stack(&[data_rows.clone(), offset_rows], ridge)
+        .solve()
+        .ok_or(FitError::Singular)
 }
 
 /// Current foot points of the data in normalised coordinates, refreshed for each trial model.
@@ -471,20 +468,24 @@ fn feet_of<const N: usize>(
     unit: &[SVector<f64, N>],
     starts: &[SVector<f64, N>],
 ) -> Option<Feet<N>> {
-    let mut points = Vec::with_capacity(unit.len());
-    let mut distances = Vec::with_capacity(unit.len());
     let checked = |u: &SVector<f64, N>, start: &SVector<f64, N>| {
         lagrange_newton(poly, u, start).filter(|f| !crosses_zero_set(poly, u, &f.point))
     };
-    for (u, start) in unit.iter().zip(starts) {
-        let foot = checked(u, start).or_else(|| {
-            let projected = project_to_zero_set(poly, u, 0.5)?;
-            checked(u, &projected)
-        })?;
-        points.push(foot.point);
-        distances.push(foot.distance);
-    }
-    Some(Feet { points, distances })
+    // Each point's foot depends only on its own start: the points are done in parallel.
+    let feet: Vec<Foot<N>> = unit
+        .par_iter()
+        .zip(starts)
+        .map(|(u, start)| {
+            checked(u, start).or_else(|| {
+                let projected = project_to_zero_set(poly, u, 0.5)?;
+                checked(u, &projected)
+            })
+        })
+        .collect::<Option<_>>()?;
+    Some(Feet {
+        points: feet.iter().map(|f| f.point).collect(),
+        distances: feet.iter().map(|f| f.distance).collect(),
+    })
 }
 
 /// Levenberg-Marquardt on the exact distances. Returns the refined polynomial and the iteration count, or `None`
@@ -498,6 +499,7 @@ fn feet_of<const N: usize>(
 /// start does, since a sliver of zero set inside a thin edge would flip the sign of every deviation there.
 fn refine_orthogonal<const N: usize>(
     start: &Poly<N>,
+    monomials: &Monomials<N>,
     unit: &[SVector<f64, N>],
     probes: Option<&SideProbes<N>>,
 ) -> Option<(Poly<N>, usize)> {
@@ -508,7 +510,7 @@ fn refine_orthogonal<const N: usize>(
         _ => true,
     };
     let projected: Vec<SVector<f64, N>> = unit
-        .iter()
+        .par_iter()
         .map(|u| project_to_zero_set(start, u, 0.5))
         .collect::<Option<_>>()?;
     let mut poly = normalise_gradient(start.clone(), &projected);
@@ -518,34 +520,35 @@ fn refine_orthogonal<const N: usize>(
     let mut damping: f64 = 1e-3;
     let m = poly.coeffs().len();
     let n = unit.len();
-    let mut row = vec![0.0; m];
     let mut iterations = 0;
     while iterations < ODR_MAX_ITERATIONS && current > 0.0 {
         iterations += 1;
         // Rows: distances (d_i changes by m(f_i) . da / |grad P(f_i)|), then a gauge row that forbids a pure change
-        // of scale (P and lambda P have the same zero set), then the damping rows.
-        let mut jac = DMatrix::<f64>::zeros(n + 1, m);
-        let mut rhs = DVector::<f64>::zeros(n + 1 + m);
-        for i in 0..n {
-            let (_, g) = poly.value_gradient(&feet.points[i]);
-            poly.basis().monomials_into(&feet.points[i], &mut row);
-            let gn = g.norm();
-            for j in 0..m {
-                jac[(i, j)] = row[j] / gn;
-            }
-            rhs[i] = -feet.distances[i];
-        }
+        // of scale (P and lambda P have the same zero set), then the damping rows. The first two are reduced once
+        // per iteration; each damping tried then only stacks its diagonal under that triangle.
         let coeffs = DVector::from_column_slice(poly.coeffs());
         let gauge = coeffs.normalize() * (n as f64).sqrt();
-        jac.row_mut(n).copy_from(&gauge.transpose());
-        let column_norms: Vec<f64> = (0..m).map(|j| jac.column(j).norm().max(1e-12)).collect();
+        let jacobian = Reduced::of_rows(n + 1, 1, m, |i, rows| {
+            if i == n {
+                rows.push(0.0).copy_from_slice(gauge.as_slice());
+                return;
+            }
+            let (_, g) = poly.value_gradient(&feet.points[i]);
+            let gn = g.norm();
+            let row = rows.push(-feet.distances[i]);
+            monomials.fill(&feet.points[i], row);
+            row.iter_mut().for_each(|v| *v /= gn);
+        });
+        let column_norms: Vec<f64> = jacobian
+            .column_norms()
+            .iter()
+            .map(|c| c.max(1e-12))
+            .collect();
         let mut accepted = false;
         for _ in 0..12 {
-            let mut system = jac.clone().insert_rows(n + 1, m, 0.0);
-            for j in 0..m {
-                system[(n + 1 + j, j)] = damping.sqrt() * column_norms[j];
-            }
-            let Some((step, _)) = least_squares(system, rhs.clone()) else {
+            let diagonal: Vec<f64> = column_norms.iter().map(|c| damping.sqrt() * c).collect();
+            let damped = Reduced::stack(std::slice::from_ref(&jacobian), Some(&diagonal));
+            let Some((step, _)) = damped.solve() else {
                 damping *= 10.0;
                 continue;
             };
@@ -578,11 +581,13 @@ fn refine_orthogonal<const N: usize>(
 
 /// Rescales P so that its gradient has unit RMS length at the given points (P is then distance-like near them).
 fn normalise_gradient<const N: usize>(mut poly: Poly<N>, at: &[SVector<f64, N>]) -> Poly<N> {
-    let mean_square = at
-        .iter()
+    // The gradients in parallel, their sum in order: the same scale whatever the number of threads, and the
+    // same as a plain sequential sum, so the refinement takes the steps it took before it ran in parallel.
+    let squares: Vec<f64> = at
+        .par_iter()
         .map(|p| poly.value_gradient(p).1.norm_squared())
-        .sum::<f64>()
-        / at.len() as f64;
+        .collect();
+    let mean_square = squares.iter().sum::<f64>() / at.len() as f64;
     let factor = 1.0 / mean_square.sqrt();
     if factor.is_finite() {
         poly.coeffs_mut().iter_mut().for_each(|c| *c *= factor);
@@ -603,7 +608,11 @@ fn measure<const N: usize>(
     let mut max = (0.0f64, points[0]);
     let mut failed = 0;
     let mut counted = 0;
-    for (p, foot) in points.iter().zip(exact.feet_along_scan(points)) {
+    let feet: Vec<_> = points
+        .par_chunks(MEASURE_RUN)
+        .flat_map_iter(|run| exact.feet_along_scan(run))
+        .collect();
+    for (p, foot) in points.iter().zip(feet) {
         match foot {
             Ok(foot) => {
                 counted += 1;

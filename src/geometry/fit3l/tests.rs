@@ -335,3 +335,85 @@ mod properties {
         }
     }
 }
+
+/// The fits of the committed reference models: profile 3 (400 and 3 000 points) at degree 4, NACA 2412 at degree 8.
+fn reference_cases() -> Vec<(&'static str, Vec<Vector2<f64>>, usize)> {
+    let truth = profile_3_truth();
+    let model = published_profile_3();
+    let (_, naca) = naca_2412_truth_and_scan(1000, 400);
+    vec![
+        (
+            "profile 3, 400 points",
+            noisy(&model, &resample_closed(&truth, 400), 0.002, 3),
+            4,
+        ),
+        (
+            "profile 3, 3000 points",
+            noisy(&model, &resample_closed(&truth, 3000), 0.002, 3),
+            4,
+        ),
+        ("NACA 2412, 400 points", naca, 8),
+    ]
+}
+
+/// 1 200 points of an ellipsoid with a bump (semi-axes 40, 30, 20 mm), its analytic normals, 2 um of noise.
+fn reference_surface() -> (Vec<nalgebra::Vector3<f64>>, Vec<nalgebra::Vector3<f64>>) {
+    use nalgebra::Vector3;
+    let count = 1200;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut rng = rand::rngs::StdRng::seed_from_u64(12);
+    let noise = Normal::new(0.0, 0.002).unwrap();
+    let axes = Vector3::new(40.0, 30.0, 20.0);
+    (0..count)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / count as f64;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * i as f64;
+            let on_sphere = Vector3::new(r * phi.cos(), r * phi.sin(), z);
+            let p = on_sphere.component_mul(&axes);
+            let n = on_sphere.component_div(&axes).normalize();
+            (p + n * noise.sample(&mut rng), n)
+        })
+        .unzip()
+}
+
+/// The models these fits gave before the fast paths (issue 17: offsets by nearest-point searches, one dense
+/// Householder QR of the whole stacked matrix per system and per damping tried), committed in
+/// reference_models.json. The fast paths reorder and chunk the same rows, so only rounding may differ.
+#[test]
+fn the_fast_paths_give_the_models_of_the_dense_path_within_1e_9() {
+    let committed: Vec<(String, Vec<f64>)> =
+        serde_json::from_str(include_str!("reference_models.json")).unwrap();
+    let mut fitted: Vec<(String, Vec<f64>)> = Vec::new();
+    for (name, points, degree) in reference_cases() {
+        for method in [FitMethod::ThreeL, FitMethod::Ridge, FitMethod::Orthogonal] {
+            let fit = fit_profile(&points, degree, method);
+            fitted.push((
+                format!("{name} {method:?}"),
+                fit.model.poly.coeffs().to_vec(),
+            ));
+        }
+    }
+    let (surface, normals) = reference_surface();
+    for method in [FitMethod::ThreeL, FitMethod::Orthogonal] {
+        let fit = fit_ip(&surface, &normals, &FitOptions::new(4, method)).unwrap();
+        fitted.push((
+            format!("surface {method:?}"),
+            fit.model.poly.coeffs().to_vec(),
+        ));
+    }
+    assert_eq!(committed.len(), fitted.len());
+    for ((name, want), (got_name, got)) in committed.iter().zip(&fitted) {
+        assert_eq!(name, got_name);
+        let scale = want.iter().fold(0.0f64, |s, c| s.max(c.abs()));
+        let worst = want
+            .iter()
+            .zip(got)
+            .map(|(w, g)| (w - g).abs())
+            .fold(0.0f64, f64::max);
+        assert!(
+            worst <= 1e-9 * scale,
+            "{name}: off by {worst:e} of {scale:e}"
+        );
+    }
+}
