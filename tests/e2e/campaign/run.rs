@@ -90,7 +90,7 @@ impl Rig {
         tally.stations += 1;
         let station = Station::quick(LINE_TIMEOUT_S);
         let transcript = TranscriptWatch::new(station.sim.transcript(MACHINE));
-        station.cli_ok(&["inspect", PART, "--serial", "SN-WHOLE"]);
+        station.inspected(&["inspect", PART, "--serial", "SN-WHOLE"]);
         let whole = checks::point_counts(&read_report(&station, "SN-WHOLE").expect("a report"));
         let profiles: BTreeSet<String> = whole.keys().map(|(_, p)| p.clone()).collect();
         let mut rig = Rig {
