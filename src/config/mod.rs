@@ -18,7 +18,9 @@ use serde::de::DeserializeOwned;
 pub use part::{
     Instances, PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, ToleranceEntry,
 };
-pub use station::{Control, Folders, MachineEntry, Pose, ProbeSettings, Safety, StationConfig};
+pub use station::{
+    Control, Folders, MachineEntry, Pose, ProbeSettings, Safety, StationConfig, Volume,
+};
 
 /// Why a configuration file cannot be used.
 #[derive(Debug, thiserror::Error)]

@@ -51,6 +51,23 @@ pub struct MachineEntry {
     pub ack_timeout_s: f64,
     /// The longest silence within a transaction: longer than the slowest move (homing); in (0, [`MAX_TIMEOUT_S`]].
     pub reply_timeout_s: f64,
+    /// Where the machine can put the ball centre, machine coordinates, mm: a move outside is refused at set-up.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub volume_mm: Option<Volume>,
+}
+
+/// A machine's travel: the box its ball centre can reach, mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Volume {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Volume {
+    pub fn contains(&self, p: &[f64; 3]) -> bool {
+        (0..3).all(|i| self.min[i] <= p[i] && p[i] <= self.max[i])
+    }
 }
 
 /// The probe the station scans with, and its speeds.
@@ -201,6 +218,20 @@ impl StationConfig {
                 safety.clearance_z_mm, safety.max_ball_radius_mm
             ));
         }
+        for machine in &self.machines {
+            let Some(volume) = &machine.volume_mm else {
+                continue;
+            };
+            let (low, high) = (volume.min[2], volume.max[2]);
+            if !(low..=high).contains(&safety.clearance_z_mm) {
+                return Err(format!(
+                    "[safety] clearance_z_mm = {} is outside machine {}'s reach in z ({low} to {high} mm, its \
+                     volume_mm): the probe could not travel at that height; give a height inside it, above the \
+                     part",
+                    safety.clearance_z_mm, machine.name
+                ));
+            }
+        }
         if !(safety.move_margin_mm >= 0.0 && safety.move_margin_mm.is_finite()) {
             return Err(format!(
                 "[safety] move_margin_mm = {} must be zero or more",
@@ -234,6 +265,20 @@ impl MachineEntry {
                      give the seconds to wait (the shipped file waits 10 s for an acknowledgement, 180 s for \
                      a reply)",
                     self.name
+                ));
+            }
+        }
+        if let Some(volume) = &self.volume_mm {
+            let sound = (0..3).all(|i| {
+                volume.min[i].is_finite()
+                    && volume.max[i].is_finite()
+                    && volume.min[i] < volume.max[i]
+            });
+            if !sound {
+                return Err(format!(
+                    "machine {}: volume_mm = {{ min = {:?}, max = {:?} }} must give finite x, y, z with each min \
+                     below its max, mm",
+                    self.name, volume.min, volume.max
                 ));
             }
         }
@@ -289,6 +334,35 @@ mod tests {
         let text = std::fs::read_to_string(shipped()).unwrap();
         std::fs::write(&path, edit(text)).unwrap();
         (dir, path)
+    }
+
+    #[test]
+    fn a_clearance_height_out_of_a_machines_reach_or_a_volume_inside_out_is_refused() {
+        let (_dir, path) =
+            edited(|t| t.replace("clearance_z_mm = 150.0", "clearance_z_mm = 600.0"));
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("clearance_z_mm = 600")
+                && message.contains("machine cmm1")
+                && message.contains("-300 to 500 mm"),
+            "{message}"
+        );
+        let (_dir, path) = edited(|t| {
+            t.replace(
+                "max = [700.0, 700.0, 500.0]",
+                "max = [700.0, -800.0, 500.0]",
+            )
+        });
+        let message = StationConfig::load(&path).unwrap_err().to_string();
+        assert!(
+            message.contains("volume_mm") && message.contains("machine cmm1"),
+            "{message}"
+        );
+        let config = StationConfig::load(&shipped()).unwrap();
+        let volume = config.machines[0]
+            .volume_mm
+            .expect("the shipped file states the travel");
+        assert!(volume.contains(&[0.0, 0.0, 150.0]) && !volume.contains(&[0.0, 0.0, 501.0]));
     }
 
     #[test]

@@ -10,7 +10,7 @@ use nalgebra::{Point3, Vector3};
 use super::clearance;
 use super::escape::ScanPath;
 use super::journal::{file_stem, JobDir, JobRecord, JobState};
-use super::motion::{job_motions, ScanMotion};
+use super::motion::{check_volumes, job_motions, ScanMotion};
 use super::pipeline::scan_ref;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::Reference;
@@ -108,11 +108,13 @@ fn plan_moves(
 ) -> Result<PlannedMoves, JobError> {
     crate::plan::check_clearance(config, plan, reference).map_err(|e| JobError(e.to_string()))?;
     let keys = job_scans(plan, kind);
-    let motions = job_motions(plan, reference, &keys, &config.safety).map_err(|e| {
-        JobError(format!(
-            "{e}; check the part file and [safety] of the station file"
-        ))
-    })?;
+    let motions = job_motions(plan, reference, &keys, &config.safety)
+        .and_then(|motions| check_volumes(&motions, &config.machines).map(|()| motions))
+        .map_err(|e| {
+            JobError(format!(
+                "{e}; check the part file and [safety] of the station file"
+            ))
+        })?;
     let part_model = match reference {
         Some(reference) => {
             let part = clearance::machine_part(plan, reference).map_err(JobError)?;

@@ -11,7 +11,7 @@ use nalgebra::{Point3, Vector3};
 use super::escape::{way_out, KnownPath};
 use crate::analysis::Reference;
 use crate::api::JobKind;
-use crate::config::Safety;
+use crate::config::{MachineEntry, Safety};
 use crate::plan::{Plan, ProfileKey};
 use zeroset_drivers::machine::{CurveScan, InPlaneScan};
 
@@ -152,6 +152,50 @@ impl ScanMotion {
     }
 }
 
+impl ScanMotion {
+    /// Every ball centre the motion goes to: the approach, the scan along its known surface, its end, the way out.
+    pub fn positions(&self) -> impl Iterator<Item = Point3<f64>> + '_ {
+        let scanned = self
+            .path
+            .surface
+            .iter()
+            .zip(&self.path.normals)
+            .map(|(p, n)| p + n * self.ball_radius_mm);
+        self.approach
+            .iter()
+            .copied()
+            .chain(scanned)
+            .chain(std::iter::once(self.end))
+            .chain(self.retract.iter().copied())
+    }
+}
+
+/// Refuses motions that would take a machine's ball centre out of its volume (`[[machines]] volume_mm`): any
+/// machine of the station may be given any scan.
+pub fn check_volumes(motions: &[ScanMotion], machines: &[MachineEntry]) -> Result<(), PlanError> {
+    for machine in machines {
+        let Some(volume) = &machine.volume_mm else {
+            continue;
+        };
+        for motion in motions {
+            if let Some(p) = motion
+                .positions()
+                .find(|p| !volume.contains(&[p.x, p.y, p.z]))
+            {
+                return Err(PlanError {
+                    scan: motion.name.clone(),
+                    problem: format!(
+                        "it would take the ball centre to ({:.3}, {:.3}, {:.3}) mm, outside machine {}'s volume \
+                         (volume_mm, min {:?}, max {:?} mm); check part_to_machine and the part's placement",
+                        p.x, p.y, p.z, machine.name, volume.min, volume.max
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The motion of every scan in `keys`, in their order.
 pub fn job_motions(
     plan: &Plan,
@@ -200,6 +244,45 @@ mod tests {
         assert_eq!(r100.retract, vec![r100.approach[1], r100.approach[0]]);
         assert!(matches!(r100.scan, Scan::InPlane(_)));
         assert!(r100.name.contains("r100"), "{}", r100.name);
+    }
+
+    fn machine(min: [f64; 3], max: [f64; 3]) -> MachineEntry {
+        MachineEntry {
+            name: "cmm1".into(),
+            port: "/dev/null".into(),
+            baud: None,
+            ack_timeout_s: 10.0,
+            reply_timeout_s: 180.0,
+            volume_mm: Some(crate::config::Volume { min, max }),
+        }
+    }
+
+    #[test]
+    fn a_scan_out_of_a_machines_volume_is_refused_naming_the_scan_and_the_machine() {
+        let plan = propeller();
+        let motions = job_motions(&plan, None, &plan.teach_scans(), &safety(150.0)).unwrap();
+        // The simulator's travel holds every move.
+        check_volumes(
+            &motions,
+            &[machine([-700.0, -700.0, -300.0], [700.0, 700.0, 500.0])],
+        )
+        .unwrap();
+        // A machine that reaches x = 450 mm at most cannot scan the r500 profile.
+        let error = check_volumes(
+            &motions,
+            &[machine([-700.0, -700.0, -300.0], [450.0, 700.0, 500.0])],
+        )
+        .unwrap_err();
+        let message = error.to_string();
+        assert!(
+            message.contains("r500")
+                && message.contains("machine cmm1")
+                && message.contains("volume_mm"),
+            "{message}"
+        );
+        // Every position counts, the approach at the clearance height included.
+        let low_ceiling = machine([-700.0, -700.0, -300.0], [700.0, 700.0, 149.0]);
+        assert!(check_volumes(&motions, &[low_ceiling]).is_err());
     }
 
     #[test]
