@@ -74,7 +74,8 @@ pub struct ReportArgs {
     /// The part's serial number: prints its newest report's summary and folder.
     #[arg(required_unless_present_any = ["trend", "export"])]
     pub serial: Option<String>,
-    /// Per profile of each instance, the mean deviation over the last parts, its spread, Cp and Cpk (mm).
+    /// Per profile of each instance, over the last parts: the worst + and worst - deviations and the form (mm),
+    /// Cp and Cpk of those against the tolerance, and the individuals-chart signals; trend.html beside it.
     #[arg(long, conflicts_with = "serial")]
     pub trend: bool,
     /// The inspection history as CSV on standard output, for spreadsheets.
