@@ -155,7 +155,7 @@ fn svg_text(text: &str) -> String {
 }
 
 /// The inline SVG documents of a page, in order.
-fn svgs(html: &str) -> Vec<&str> {
+pub(crate) fn svgs(html: &str) -> Vec<&str> {
     html.match_indices("<svg")
         .map(|(start, _)| {
             let end = html[start..].find("</svg>").expect("an <svg> is closed") + start;

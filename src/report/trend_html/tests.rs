@@ -1,6 +1,7 @@
 use quick_xml::events::Event;
 
 use super::*;
+use crate::report::html::tests::svgs;
 use crate::report::store::ProfileRecord;
 use crate::report::trend::trend;
 
@@ -107,16 +108,6 @@ fn rows_of(table: &str) -> Vec<Vec<Cell>> {
 
 fn texts(row: &[Cell]) -> Vec<&str> {
     row.iter().map(|c| c.text.as_str()).collect()
-}
-
-/// The inline SVG documents of a page, in order.
-fn svgs(html: &str) -> Vec<&str> {
-    html.match_indices("<svg")
-        .map(|(start, _)| {
-            let end = html[start..].find("</svg>").expect("an <svg> is closed") + start;
-            &html[start..end + "</svg>".len()]
-        })
-        .collect()
 }
 
 #[test]

@@ -472,12 +472,12 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     // A daemon was killed with the ball under the circle (z = -21); the new daemon knows the cut scan's path.
     let position = Xyz::new(100.0, 0.0, -21.0);
     let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
+    // It also knows an older cut scan 300 mm away, listed first: the ball leaves by the scan it is on.
     let escape = EscapeModel {
-        paths: vec![ScanPath {
-            name: "instance B, profile r300".into(),
-            path: circle(),
-            margin_mm: MARGIN_MM,
-        }],
+        paths: vec![
+            scan_path("instance A, profile r100", 300.0),
+            scan_path("instance B, profile r300", 0.0),
+        ],
         part: None,
         deviation_margin_mm: MARGIN_MM,
     };
@@ -834,35 +834,7 @@ fn scan_path(name: &str, shift_y_mm: f64) -> ScanPath {
 }
 
 #[tokio::test]
-async fn after_a_restart_the_probe_leaves_by_the_scan_it_is_on_whichever_was_cut_last() {
-    // A restarted daemon knows an old cut scan 300 mm away and the job's planned scans: the ball under the circle
-    // leaves along the circle's path, the one it is on.
-    let position = Xyz::new(100.0, 0.0, -21.0);
-    let moves = Arc::new(Mutex::new(Vec::new()));
-    let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
-    let escape = EscapeModel {
-        paths: vec![
-            scan_path("instance A, profile r100", 300.0),
-            scan_path("instance B, profile r300", 0.0),
-        ],
-        part: None,
-        deviation_margin_mm: MARGIN_MM,
-    };
-    let planned = plan_escape(
-        Point3::new(position.x, position.y, position.z),
-        Some((&circle(), MARGIN_MM)),
-        1.0,
-        &safety(),
-        &escape,
-    )
-    .unwrap();
-    clear(&worker, escape).await.expect("cleared");
-    assert_eq!(
-        *moves.lock().unwrap(),
-        planned.iter().map(xyz_of).collect::<Vec<_>>()
-    );
-
-    // Far from every scan it knows, it refuses and names the nearest.
+async fn far_from_every_scan_it_knows_a_clear_moves_nothing_and_names_the_nearest() {
     let moves = Arc::new(Mutex::new(Vec::new()));
     let (worker, _reports) = worker_on(machine(
         vec![Xyz::new(100.0, 150.0, 10.0)],
