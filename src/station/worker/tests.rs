@@ -473,14 +473,7 @@ async fn a_cleared_machine_leaves_the_part_along_the_path_of_the_cut_scan() {
     let position = Xyz::new(100.0, 0.0, -21.0);
     let (worker, _reports) = worker_on(machine(vec![position], moves.clone(), Vec::new()));
     // It also knows an older cut scan 300 mm away, listed first: the ball leaves by the scan it is on.
-    let escape = EscapeModel {
-        paths: vec![
-            scan_path("instance A, profile r100", 300.0),
-            scan_path("instance B, profile r300", 0.0),
-        ],
-        part: None,
-        deviation_margin_mm: MARGIN_MM,
-    };
+    let escape = restarted_escape();
     // What the escape planner gives (and checks) for the same stop is what goes on the wire.
     let planned = plan_escape(
         Point3::new(position.x, position.y, position.z),
@@ -821,6 +814,18 @@ async fn a_port_that_cannot_be_opened_is_seen_before_any_job() {
     assert!(fault.message.contains("/dev/ttyUSB7"), "{}", fault.message);
 }
 
+/// What a restarted daemon gives a clear: an older cut scan 300 mm away, listed first, then the circle's scan.
+fn restarted_escape() -> EscapeModel {
+    EscapeModel {
+        paths: vec![
+            scan_path("instance A, profile r100", 300.0),
+            scan_path("instance B, profile r300", 0.0),
+        ],
+        part: None,
+        deviation_margin_mm: MARGIN_MM,
+    }
+}
+
 fn scan_path(name: &str, shift_y_mm: f64) -> ScanPath {
     let mut path = circle();
     for p in &mut path.surface {
@@ -841,14 +846,7 @@ async fn far_from_every_scan_it_knows_a_clear_moves_nothing_and_names_the_neares
         moves.clone(),
         Vec::new(),
     ));
-    let escape = EscapeModel {
-        paths: vec![
-            scan_path("instance A, profile r100", 300.0),
-            scan_path("instance B, profile r300", 0.0),
-        ],
-        part: None,
-        deviation_margin_mm: MARGIN_MM,
-    };
+    let escape = restarted_escape();
     let error = clear(&worker, escape).await.unwrap_err();
     assert_eq!(error.kind, FaultKind::Refused);
     assert!(
