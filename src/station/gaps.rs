@@ -12,8 +12,10 @@ use super::motion::{Scan, ScanMotion};
 
 /// A step is a gap when it is longer than this many times the median of the steps before it...
 const LOCAL_FACTOR: f64 = 3.0;
-/// ...and longer than this many times the largest spacing of the nominal points (a curve scan) or the step
-/// (a teach scan): a machine reports at least one point per nominal, and a teach scan one per step.
+/// ...and longer than this many times the spacing there: the longest nominal segment the step spans (a curve
+/// scan) or the step (a teach scan), since a machine reports at least one point per nominal, and a teach scan
+/// one per step. The spacing is local, not the curve's largest: a blade's nominals crowd at its edges, and a
+/// line of points lost there is shorter than one spacing of its faces.
 const SPACING_FACTOR: f64 = 1.5;
 /// How many steps the local median looks back over.
 const WINDOW: usize = 10;
@@ -54,17 +56,47 @@ pub fn find_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
     }
 }
 
-/// The first step longer than its allowance: `SPACING_FACTOR * spacing`, and `LOCAL_FACTOR` times the local
-/// median step.
-fn first_long_step(positions: &[f64], spacing: f64) -> Option<(usize, f64)> {
+/// The first step longer than its allowance: `SPACING_FACTOR` times the spacing over it (`spacing(from, to)`),
+/// and `LOCAL_FACTOR` times the local median step.
+fn first_long_step(positions: &[f64], spacing: impl Fn(f64, f64) -> f64) -> Option<(usize, f64)> {
     let steps: Vec<f64> = positions.windows(2).map(|w| w[1] - w[0]).collect();
     (0..steps.len()).find_map(|i| {
         let mut before: Vec<f64> = steps[i.saturating_sub(WINDOW)..i].to_vec();
         before.sort_by(f64::total_cmp);
         let median = before.get(before.len() / 2).copied().unwrap_or(0.0);
-        let allowed = (SPACING_FACTOR * spacing).max(LOCAL_FACTOR * median);
+        let allowed =
+            (SPACING_FACTOR * spacing(positions[i], positions[i + 1])).max(LOCAL_FACTOR * median);
         (steps[i] > allowed).then_some((i, steps[i]))
     })
+}
+
+/// The nominal segments of a curve scan in the order it travels them, as arc lengths from its entry.
+struct Segments {
+    /// (where the segment starts, its length), mm, starts increasing.
+    spans: Vec<(f64, f64)>,
+    /// The longest of all, for a path that has none ahead of its entry.
+    widest: f64,
+}
+
+impl Segments {
+    /// The longest segment that overlaps `from..to` (arc lengths from the entry, mm); a step that spans none
+    /// (it lies on one segment's end) gets the segment it touches.
+    fn spacing(&self, from: f64, to: f64) -> f64 {
+        let spans = &self.spans;
+        if spans.is_empty() {
+            return self.widest;
+        }
+        let first = spans
+            .partition_point(|&(start, length)| start + length < from)
+            .min(spans.len() - 1);
+        let past = spans
+            .partition_point(|&(start, _)| start <= to)
+            .max(first + 1);
+        spans[first..past.min(spans.len())]
+            .iter()
+            .map(|&(_, length)| length)
+            .fold(0.0, f64::max)
+    }
 }
 
 fn curve_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
@@ -80,6 +112,20 @@ fn curve_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
     }
     let spacing = (0..segments).map(length).fold(0.0, f64::max);
     let entry = start_of.get(path.entry).copied().unwrap_or(0.0);
+    let mut spans: Vec<(f64, f64)> = (0..segments)
+        .filter_map(|i| {
+            let mut from = start_of[i] - entry;
+            if path.closed && from < 0.0 {
+                from += total;
+            }
+            (from >= 0.0).then(|| (from, length(i)))
+        })
+        .collect();
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let travelled = Segments {
+        spans,
+        widest: spacing,
+    };
     // Arc lengths from the entry, in the direction of travel, each looked for ahead of the last.
     let mut positions = Vec::with_capacity(centres.len());
     let mut last = 0.0;
@@ -109,15 +155,14 @@ fn curve_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
             length_mm: total,
         });
     };
-    let allowed = SPACING_FACTOR * spacing;
-    if first > allowed {
+    if first > SPACING_FACTOR * travelled.spacing(0.0, first) {
         return Some(Gap {
             after: None,
             at: path.surface[path.entry],
             length_mm: first,
         });
     }
-    if let Some((i, step)) = first_long_step(&positions, spacing) {
+    if let Some((i, step)) = first_long_step(&positions, |from, to| travelled.spacing(from, to)) {
         return Some(Gap {
             after: Some(i),
             at: centres[i],
@@ -125,8 +170,9 @@ fn curve_gap(motion: &ScanMotion, centres: &[Point3<f64>]) -> Option<Gap> {
         });
     }
     let end = if path.closed { total } else { total - entry };
-    let short = end - positions[positions.len() - 1];
-    (short > allowed).then(|| Gap {
+    let last = positions[positions.len() - 1];
+    let short = end - last;
+    (short > SPACING_FACTOR * travelled.spacing(last, end)).then(|| Gap {
         after: Some(centres.len() - 1),
         at: centres[centres.len() - 1],
         length_mm: short,
@@ -150,7 +196,7 @@ fn teach_gap(
     for pair in centres.windows(2) {
         travelled.push(travelled[travelled.len() - 1] + (pair[1] - pair[0]).norm());
     }
-    if let Some((i, length)) = first_long_step(&travelled, step) {
+    if let Some((i, length)) = first_long_step(&travelled, |_, _| step) {
         return Some(Gap {
             after: Some(i),
             at: centres[i],

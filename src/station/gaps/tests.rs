@@ -153,3 +153,29 @@ fn a_teach_scan_is_whole_when_its_steps_are_and_it_closes() {
     let cut = &whole[..turn - 10];
     assert_eq!(find_gap(&motion, cut).unwrap().after, Some(turn - 11));
 }
+
+#[test]
+fn the_last_few_points_lost_where_the_nominals_crowd_are_a_gap() {
+    // The NACA's nominals crowd at its edges: entered at the leading edge, the scan ends there, where a data
+    // line cut short (its last points lost) is shorter than one spacing of the faces.
+    for (count, per, offset) in [(200, 1, 0.4), (272, 1, -0.4), (390, 1, 0.0), (200, 2, 0.4)] {
+        let mut path = naca_path(count);
+        path.entry = (0..count)
+            .min_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
+            .unwrap();
+        let motion = curve_motion(path.clone());
+        let mut whole = centres(&path, offset, per);
+        whole.rotate_left(path.entry * per);
+        assert_eq!(find_gap(&motion, &whole), None, "{count} nominals whole");
+        for lost in 1 + per..=10 {
+            let cut = &whole[..whole.len() - lost];
+            let gap = find_gap(&motion, cut)
+                .unwrap_or_else(|| panic!("{count} nominals, the last {lost} points lost"));
+            assert_eq!(gap.after, Some(cut.len() - 1), "{gap}");
+        }
+        // And the first line, where the scan enters (the nominals there grow apart too fast for a point or
+        // two to tell from their spacing).
+        let gap = find_gap(&motion, &whole[10..]).expect("the first line lost");
+        assert_eq!(gap.after, None, "{gap}");
+    }
+}
