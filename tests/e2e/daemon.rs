@@ -20,6 +20,8 @@ pub struct Station {
     pub station_file: PathBuf,
     daemon: Option<Child>,
     daemons_started: usize,
+    /// The daemon's log filter (`ZEROSET_LOG`), when not its default.
+    log_filter: Option<&'static str>,
 }
 
 impl Station {
@@ -63,6 +65,7 @@ impl Station {
             station_file,
             daemon: None,
             daemons_started: 0,
+            log_filter: None,
         };
         station.start_daemon();
         station
@@ -105,13 +108,16 @@ impl Station {
                 .join(format!("daemon-{}.stderr", self.daemons_started)),
         )
         .expect("a log file");
-        let child = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        let mut command = Command::new(env!("CARGO_BIN_EXE_zeroset"));
+        command
             .args(["daemon", "--config"])
             .arg(&self.station_file)
             .current_dir(repo())
-            .stderr(log)
-            .spawn()
-            .expect("the daemon starts");
+            .stderr(log);
+        if let Some(filter) = self.log_filter {
+            command.env("ZEROSET_LOG", filter);
+        }
+        let child = command.spawn().expect("the daemon starts");
         self.daemon = Some(child);
         zeroset::cli::demo::wait_for_socket(&self.socket()).expect("the daemon starts serving");
     }
@@ -143,6 +149,19 @@ impl Station {
     }
 
     /// `kill -9`: no chance to tidy up.
+    /// From now on (the daemon restarted at once), the daemon logs every line it sends and reads, to
+    /// [`Station::daemon_log`].
+    pub fn log_wire(&mut self) {
+        self.log_filter = Some("info,zeroset_drivers::client::actor=debug");
+        self.kill_daemon();
+        self.start_daemon();
+    }
+
+    /// The daemon's JSON log.
+    pub fn daemon_log(&self) -> PathBuf {
+        self.root.path().join("logs/zeroset-daemon.jsonl")
+    }
+
     pub fn kill_daemon(&mut self) {
         let mut child = self.daemon.take().expect("a running daemon");
         child.kill().expect("SIGKILL");

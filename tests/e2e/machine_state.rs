@@ -70,8 +70,7 @@ fn an_emergency_stop_and_a_lost_simulator_show_in_status_and_one_clear_recovers_
 
     // The log an operator reads: each command and its outcome, the faults seen, and no terminal colour codes in
     // a log file.
-    let log =
-        std::fs::read_to_string(station.root.path().join("logs/zeroset-daemon.jsonl")).unwrap();
+    let log = std::fs::read_to_string(station.daemon_log()).unwrap();
     let lines: Vec<serde_json::Value> = log
         .lines()
         .map(|line| serde_json::from_str(line).expect("one JSON object per line"))

@@ -14,6 +14,7 @@ use super::checks::{self, Counts};
 use super::plan::{Fault, Kind, Moment, Planner};
 use super::tally::Tally;
 use super::transcript::TranscriptWatch;
+use super::wire_log::WireLog;
 use crate::daemon::{Station, Watcher};
 
 const MACHINE: &str = "cmm1";
@@ -88,8 +89,10 @@ struct Rig {
 impl Rig {
     fn new(tally: &mut Tally) -> Rig {
         tally.stations += 1;
-        let station = Station::quick(LINE_TIMEOUT_S);
-        let transcript = TranscriptWatch::new(station.sim.transcript(MACHINE));
+        let mut station = Station::quick(LINE_TIMEOUT_S);
+        station.log_wire();
+        let wire = WireLog::new(station.daemon_log(), MACHINE);
+        let transcript = TranscriptWatch::new(station.sim.transcript(MACHINE), wire);
         station.inspected(&["inspect", PART, "--serial", "SN-WHOLE"]);
         let whole = checks::point_counts(&read_report(&station, "SN-WHOLE").expect("a report"));
         let profiles: BTreeSet<String> = whole.keys().map(|(_, p)| p.clone()).collect();

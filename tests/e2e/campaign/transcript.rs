@@ -1,12 +1,14 @@
 //! The simulator's transcript (what the machine received and sent), read as the campaign goes: every motion
 //! command the machine received while an error of severity 2 or more (an emergency stop's included) stood
-//! uncleared, every collision or missing surface that no injected fault explains, and which faults fired.
+//! uncleared, unless the daemon's log shows it sent before the error was read (the two crossed on the line),
+//! every collision or missing surface that no injected fault explains, and which faults fired.
 
 use std::collections::BTreeMap;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::PathBuf;
 
 use super::plan::Kind;
+use super::wire_log::WireLog;
 
 /// Commands that move the probe (the settings around them, ScanOnCurveDensity and the like, do not).
 const MOTION: [&str; 14] = [
@@ -35,6 +37,8 @@ const SURFACE_NOT_FOUND: &str = "1006";
 /// The error that put the machine in its error state, until ClearAllErrors.
 struct Standing {
     line: String,
+    /// The error line as the machine sent it (None: the simulator dropped it, so the station never saw it).
+    sent: Option<String>,
     code: String,
     at: f64,
     /// A StartSession came since (the simulator, as the spec says, clears errors then too).
@@ -53,6 +57,7 @@ struct Armed {
 
 pub(crate) struct TranscriptWatch {
     path: PathBuf,
+    wire: WireLog,
     offset: u64,
     /// The end of the last read when it fell inside a line.
     partial: String,
@@ -62,9 +67,11 @@ pub(crate) struct TranscriptWatch {
 }
 
 impl TranscriptWatch {
-    pub(crate) fn new(path: PathBuf) -> TranscriptWatch {
+    /// The transcript at `path`; `wire` the daemon's log of the same machine's line.
+    pub(crate) fn new(path: PathBuf, wire: WireLog) -> TranscriptWatch {
         TranscriptWatch {
             path,
+            wire,
             offset: 0,
             partial: String::new(),
             standing: None,
@@ -100,6 +107,8 @@ impl TranscriptWatch {
         text.push_str(&String::from_utf8_lossy(&bytes));
         let complete = text.rfind('\n').map_or(0, |end| end + 1);
         self.partial = text[complete..].to_string();
+        // Read after the transcript: whatever the daemon sent that the machine received is in it.
+        self.wire.read_on();
         text[..complete]
             .lines()
             .filter_map(|line| self.entry(line))
@@ -133,7 +142,7 @@ impl TranscriptWatch {
             self.count(Kind::DropLines);
             // The machine is in error whether or not the station ever saw the line.
             if let Some((severity, _)) = error_of(dropped) {
-                self.error_stands(severity, &format!("{text} (dropped)"), at);
+                self.error_stands(severity, &format!("{text} (dropped)"), None, at);
             }
         }
         None
@@ -145,7 +154,7 @@ impl TranscriptWatch {
             return None;
         }
         let (severity, code) = error_of(text)?;
-        self.error_stands(severity, line, at);
+        self.error_stands(severity, line, Some(text), at);
         let unexplained = match code {
             EMERGENCY_STOP => {
                 self.count(Kind::Estop);
@@ -181,9 +190,13 @@ impl TranscriptWatch {
             }
             _ if MOTION.contains(&name) => {
                 let standing = self.standing.as_mut().filter(|s| !s.reported)?;
+                let knew = match &standing.sent {
+                    Some(error) => self.wire.knew(error, standing.at, &shorten(text))?,
+                    None => "the error line was dropped".to_string(),
+                };
                 standing.reported = true;
                 Some(format!(
-                    "motion {:.0} ms after an error, before ClearAllErrors{} (the first of this error's window): `{}` then `{}`",
+                    "motion {:.0} ms after an error, before ClearAllErrors{} (the first of this error's window; {knew}): `{}` then `{}`",
                     (at - standing.at) * 1000.0,
                     if standing.new_session {
                         " (a new session came between)"
@@ -198,10 +211,11 @@ impl TranscriptWatch {
         }
     }
 
-    fn error_stands(&mut self, severity: u32, line: &str, at: f64) {
+    fn error_stands(&mut self, severity: u32, line: &str, sent: Option<&str>, at: f64) {
         if severity >= 2 && self.standing.is_none() {
             self.standing = Some(Standing {
                 line: shorten(line),
+                sent: sent.map(shorten),
                 code: error_of(line).map_or(String::new(), |(_, code)| code.to_string()),
                 at,
                 new_session: false,
@@ -231,7 +245,7 @@ impl TranscriptWatch {
 }
 
 /// A transcript line cut to its first 160 characters (a scan's command carries its whole path).
-fn shorten(line: &str) -> String {
+pub(super) fn shorten(line: &str) -> String {
     match line.char_indices().nth(160) {
         Some((end, _)) => format!("{}...", &line[..end]),
         None => line.to_string(),
@@ -254,9 +268,56 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.log");
         std::fs::write(&path, lines.join("\n") + "\n").unwrap();
-        let mut watch = TranscriptWatch::new(path);
+        let wire = WireLog::new(dir.path().join("zeroset-daemon.jsonl"), "cmm1");
+        let mut watch = TranscriptWatch::new(path, wire);
         let found = watch.read_on();
         (watch, found, dir)
+    }
+
+    #[test]
+    fn a_motion_that_crossed_the_error_on_the_line_is_not_the_stations_but_the_next_one_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let estop = "E0000 ! Error(3, 0500, \"EmergencyStop\", \"Emergency stop\")";
+        // The daemon sent 00012 at 10:00:01.000000 and read the stop 0.3 ms later, then sent 00013 before
+        // ClearAllErrors.
+        let logged = [
+            (
+                "2026-12-02T10:00:01.000000Z",
+                "> 00012 GoTo(X(1))".to_string(),
+            ),
+            ("2026-12-02T10:00:01.000300Z", format!("< {estop}")),
+            (
+                "2026-12-02T10:00:01.000400Z",
+                "> 00013 GoTo(X(2))".to_string(),
+            ),
+        ];
+        let log: Vec<String> = logged
+            .iter()
+            .map(|(at, message)| {
+                serde_json::json!({"timestamp": at, "fields": {"message": message, "machine": "cmm1"}})
+                    .to_string()
+            })
+            .collect();
+        std::fs::write(
+            dir.path().join("zeroset-daemon.jsonl"),
+            log.join("\n") + "\n",
+        )
+        .unwrap();
+        let path = dir.path().join("t.log");
+        let transcript = [
+            format!("1796205601.000100 > {estop}"),
+            "1796205601.000150 < 00012 GoTo(X(1))".to_string(),
+            "1796205601.000450 < 00013 GoTo(X(2))".to_string(),
+        ];
+        std::fs::write(&path, transcript.join("\n") + "\n").unwrap();
+        let wire = WireLog::new(dir.path().join("zeroset-daemon.jsonl"), "cmm1");
+        let found = TranscriptWatch::new(path, wire).read_on();
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(
+            found[0].contains("00013 GoTo") && found[0].contains("had read the error"),
+            "{}",
+            found[0]
+        );
     }
 
     #[test]
