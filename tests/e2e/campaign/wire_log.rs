@@ -134,7 +134,7 @@ mod tests {
         let mut log = WireLog::new(path, "cmm1");
         log.read_on();
         // The machine sent the stop at 10:00:01.000100, just after the first GoTo left the daemon.
-        let error_at = 1_796_205_601.000_100;
+        let error_at = 1_796_205_601.0 + 100e-6;
         assert_eq!(log.knew(estop, error_at, "00021 GoTo(X(1))"), None);
         assert!(log.knew(estop, error_at, "00022 GoTo(X(2))").is_some());
         assert!(log.knew(estop, error_at, "00023 GoTo(X(3))").is_some());
