@@ -11,6 +11,11 @@ use super::ScanRef;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "state", rename_all = "snake_case")]
 pub enum MachineState {
+    /// The daemon has not yet opened its line and read its state: until it has, it is not called idle (an
+    /// emergency stop pressed before the daemon opened the line is cleared by the session's start, as the I++
+    /// spec's StartSession clears all errors, so "idle" before a look would be a guess). A job may start; its
+    /// scans wait for the look.
+    Unseen,
     /// Ready for the next scan.
     Idle,
     Scanning {
@@ -104,6 +109,7 @@ impl fmt::Display for JobPhase {
 impl fmt::Display for MachineState {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            Self::Unseen => f.write_str("not seen yet (opening its line and reading its state)"),
             Self::Idle => f.write_str("idle"),
             Self::Scanning { scan } => {
                 write!(

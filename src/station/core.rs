@@ -53,6 +53,10 @@ pub enum Input {
         key: ProfileKey,
         result: Result<(), String>,
     },
+    /// A worker's watch looked at its machine for the first time and found it ready.
+    Seen {
+        machine: String,
+    },
     /// A worker's watch saw its idle machine stop: an alarm, an emergency stop, a lost line, a missing port.
     Observed {
         machine: String,
@@ -151,7 +155,7 @@ const CLEAR_TO_CONTINUE: &str =
     "remove the cause, then run `zeroset clear`: the job continues from its last complete profile";
 
 impl Core {
-    /// The station's machines, all idle, and a job a previous daemon left open (stopped until `zeroset clear`).
+    /// The station's machines, not yet seen, and a job a previous daemon left open (stopped until `zeroset clear`).
     pub fn new(station: String, machines: Vec<String>, reopened: Option<Job>) -> Core {
         // A job left open means a daemon stopped while it ran: where its probes are is not known, so each machine
         // starts locked out, and only `zeroset clear` (with the cut scans' ways out) lifts that.
@@ -165,7 +169,7 @@ impl Core {
                     ),
                 },
             },
-            None => MachineState::Idle,
+            None => MachineState::Unseen,
         };
         Core {
             station,
@@ -202,6 +206,7 @@ impl Core {
             } => self.scan_ended(&machine, key, result),
             Input::Stored { job, key, result } => self.stored(&job, key, result),
             Input::Cleared { machine, result } => self.cleared(&machine, result),
+            Input::Seen { machine } => self.seen(&machine),
             Input::Observed { machine, fault } => self.observed(&machine, fault),
             Input::Finished { job, result } => self.finished(&job, result),
         }
@@ -322,7 +327,7 @@ impl Core {
         let blocked: Vec<String> = self
             .slots
             .iter()
-            .filter(|s| !matches!(s.state, MachineState::Idle))
+            .filter(|s| !matches!(s.state, MachineState::Idle | MachineState::Unseen))
             .map(|s| format!("machine {} is {}", s.name, s.state))
             .collect();
         (!blocked.is_empty()).then(|| {
@@ -484,11 +489,25 @@ impl Core {
         self.abort_done_if_stopped();
     }
 
+    /// The watch's first look found the machine ready: it may take scans. (A machine locked out or cleared since
+    /// stays as it is.)
+    fn seen(&mut self, machine: &str) {
+        if let Some(slot) = self
+            .slot(machine)
+            .filter(|s| s.state == MachineState::Unseen)
+        {
+            slot.state = MachineState::Idle;
+        }
+    }
+
     /// The watch of an idle machine saw it stop (an alarm, an emergency stop, its line or port gone): it is
     /// locked out until the operator's clear, and a running job stops, since the machine can take no more of its
     /// scans. A machine busy with an order hears of the fault through the order's end instead.
     fn observed(&mut self, machine: &str, fault: WorkerError) {
-        let Some(slot) = self.slot(machine).filter(|s| s.state == MachineState::Idle) else {
+        let Some(slot) = self
+            .slot(machine)
+            .filter(|s| matches!(s.state, MachineState::Idle | MachineState::Unseen))
+        else {
             return;
         };
         slot.state = MachineState::LockedOut {

@@ -128,6 +128,7 @@ pub fn spawn_on(
         ball_radius: None,
         path: None,
         fault: None,
+        seen: false,
     };
     tokio::spawn(worker.run(inbox, watch, daemon));
     handle
@@ -176,6 +177,8 @@ struct Worker {
     path: Option<ScanPath>,
     /// Why the machine may not move until the operator's clear: a failed order, or what the watch saw while idle.
     fault: Option<WorkerError>,
+    /// Whether the watch has told the daemon the machine is ready (once, at its first healthy look).
+    seen: bool,
 }
 
 /// How a scan order ended.

@@ -18,7 +18,17 @@ struct Bench {
 }
 
 impl Bench {
+    /// A station whose machine its worker has looked at and found ready.
     fn new() -> Bench {
+        let mut bench = Bench::unseen();
+        bench.core.handle(Input::Seen {
+            machine: MACHINE.into(),
+        });
+        bench
+    }
+
+    /// A station whose machine its worker has not looked at yet.
+    fn unseen() -> Bench {
         let data = tempfile::tempdir().unwrap();
         let mut config = StationConfig::load(
             &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("config/station.toml"),
@@ -633,6 +643,46 @@ fn a_fault_seen_on_an_idle_machine_locks_it_out_and_no_job_starts_until_a_clear(
         result: Ok(()),
     });
     assert_eq!(bench.machine(), MachineState::Idle);
+}
+
+#[test]
+fn a_machine_not_yet_looked_at_is_not_called_idle_and_takes_a_job_s_scans_only_once_seen() {
+    let mut bench = Bench::unseen();
+    assert_eq!(bench.machine(), MachineState::Unseen);
+    assert!(bench.machine().to_string().starts_with("not seen yet"));
+    // A job may start, but nothing is sent to a machine whose state is not known.
+    let effects = bench.start_teach();
+    assert_eq!(scanned(&effects), None);
+    assert_eq!(bench.phase(), JobPhase::Running);
+    // The first look finds it ready: the job's first scan goes out.
+    let effects = bench.core.handle(Input::Seen {
+        machine: MACHINE.into(),
+    });
+    assert!(scanned(&effects).is_some());
+    assert!(matches!(bench.machine(), MachineState::Scanning { .. }));
+    // A late "seen" changes nothing.
+    bench.core.handle(Input::Seen {
+        machine: MACHINE.into(),
+    });
+    assert!(matches!(bench.machine(), MachineState::Scanning { .. }));
+}
+
+#[test]
+fn a_machine_found_stopped_at_its_first_look_is_locked_out_and_a_job_waiting_for_it_stops() {
+    let mut bench = Bench::unseen();
+    bench.start_teach();
+    let effects = bench.core.handle(Input::Observed {
+        machine: MACHINE.into(),
+        fault: estop(),
+    });
+    assert!(!touches_a_machine(&effects));
+    assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
+    assert!(matches!(bench.phase(), JobPhase::Stopped { .. }));
+    // Being seen afterwards does not lift the lockout: only a clear does.
+    bench.core.handle(Input::Seen {
+        machine: MACHINE.into(),
+    });
+    assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
 }
 
 #[test]

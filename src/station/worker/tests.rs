@@ -523,6 +523,22 @@ fn lost(command: &str) -> MachineError {
     )
 }
 
+/// I++ 0008 for `command`: what a controller answers on a session it does not (or already) hold.
+fn protocol_error(command: &str) -> MachineError {
+    let error = zeroset_drivers::wire::DeviceError::new(
+        3,
+        PROTOCOL_ERROR,
+        zeroset_drivers::wire::WireString::new(command).unwrap(),
+        zeroset_drivers::wire::WireString::new("Protocol error").unwrap(),
+    )
+    .unwrap();
+    MachineError::new(
+        "cmm1".into(),
+        format!("{command}()"),
+        ErrorKind::Device(error),
+    )
+}
+
 #[tokio::test]
 async fn a_lost_link_is_opened_again_by_the_next_order_not_reused() {
     let opened = Arc::new(Mutex::new(0usize));
@@ -573,20 +589,9 @@ async fn a_clear_on_a_session_the_machine_lost_starts_it_again() {
         .expect_clear_all_errors()
         .times(1)
         .returning(|| Ok(()));
-    machine.expect_clear_all_errors().returning(|| {
-        let error = zeroset_drivers::wire::DeviceError::new(
-            3,
-            PROTOCOL_ERROR,
-            zeroset_drivers::wire::WireString::new("ClearAllErrors").unwrap(),
-            zeroset_drivers::wire::WireString::new("Protocol error").unwrap(),
-        )
-        .unwrap();
-        Err(MachineError::new(
-            "cmm1".into(),
-            "ClearAllErrors()".into(),
-            ErrorKind::Device(error),
-        ))
-    });
+    machine
+        .expect_clear_all_errors()
+        .returning(|| Err(protocol_error("ClearAllErrors")));
     machine.expect_end_session().returning(|| Ok(()));
     let (worker, _reports) = worker_on(machine);
     for _ in 0..2 {
@@ -709,9 +714,44 @@ fn observed(message: Option<DaemonMsg>) -> WorkerError {
     }
 }
 
+fn seen(message: Option<DaemonMsg>) {
+    assert!(
+        matches!(&message, Some(DaemonMsg::Input(Input::Seen { machine })) if machine == "cmm1"),
+        "expected the first look's 'ready'"
+    );
+}
+
+#[tokio::test]
+async fn a_machine_holding_a_killed_daemon_s_session_is_still_looked_at() {
+    let (alarms, _) = broadcast::channel(8);
+    // StartSession: 0008, the session of the daemon that was killed is still open; GetErrStatusE answers on it.
+    let (_worker, mut reports) =
+        watched_with_session(&alarms, || Err(protocol_error("StartSession")), || Ok(true));
+    let fault = observed(
+        tokio::time::timeout(Duration::from_secs(2), reports.recv())
+            .await
+            .unwrap(),
+    );
+    assert_eq!(fault.kind, FaultKind::LockedOut, "{}", fault.message);
+    assert!(
+        fault.message.contains("error state while idle"),
+        "{}",
+        fault.message
+    );
+}
+
 /// An idle machine under a fast watch, its alarms sent through `alarms`, GetErrStatusE answered by `in_error`.
 fn watched(
     alarms: &broadcast::Sender<Event>,
+    in_error: impl Fn() -> Result<bool, MachineError> + Send + 'static,
+) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
+    watched_with_session(alarms, || Ok(()), in_error)
+}
+
+/// Like [`watched`], StartSession answered by `start_session`.
+fn watched_with_session(
+    alarms: &broadcast::Sender<Event>,
+    start_session: impl Fn() -> Result<(), MachineError> + Send + 'static,
     in_error: impl Fn() -> Result<bool, MachineError> + Send + 'static,
 ) -> (WorkerHandle, mpsc::Receiver<DaemonMsg>) {
     let mut machine = MockMachine::new();
@@ -719,7 +759,7 @@ fn watched(
     machine
         .expect_events()
         .returning(move || alarms.subscribe());
-    machine.expect_start_session().returning(|| Ok(()));
+    machine.expect_start_session().returning(start_session);
     machine.expect_in_error().returning(in_error);
     machine.expect_go_to().never();
     let machine: Link = Arc::new(machine);
@@ -740,7 +780,8 @@ fn watched(
 async fn an_emergency_stop_on_an_idle_machine_is_seen_at_once_and_the_next_scan_sends_nothing() {
     let (alarms, _) = broadcast::channel(8);
     let (worker, mut reports) = watched(&alarms, || Ok(false));
-    // A few looks at a healthy machine report nothing.
+    // The first look at a healthy machine says it is ready; the next few report nothing.
+    seen(reports.recv().await);
     tokio::time::sleep(Duration::from_millis(100)).await;
     assert!(reports.try_recv().is_err());
     let estop = zeroset_drivers::wire::DeviceError::new(

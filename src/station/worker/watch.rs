@@ -113,13 +113,14 @@ impl Worker {
             match client.start_session().await {
                 Ok(()) => self.session = true,
                 // The machine holds the session of a daemon that was killed: the next order takes it over (which
-                // clears the machine's errors, so only an order the operator asked for does it).
-                Err(error) if is_protocol_error(&error) => return,
+                // clears the machine's errors, so only an order the operator asked for does it). That session
+                // still answers GetErrStatusE, so the look goes on: a machine that is never looked at is blind.
+                Err(error) if is_protocol_error(&error) => {}
                 Err(error) => return self.observe(error.into(), daemon).await,
             }
         }
         match client.in_error().await {
-            Ok(false) => {}
+            Ok(false) => self.tell_seen(daemon).await,
             Ok(true) => {
                 let fault = WorkerError {
                     kind: FaultKind::LockedOut,
@@ -133,6 +134,18 @@ impl Worker {
             }
             Err(error) => self.observe(error.into(), daemon).await,
         }
+    }
+
+    /// The first healthy look tells the daemon the machine is ready (it is not called idle before).
+    async fn tell_seen(&mut self, daemon: &mpsc::Sender<DaemonMsg>) {
+        if std::mem::replace(&mut self.seen, true) {
+            return;
+        }
+        let _ = daemon
+            .send(DaemonMsg::Input(Input::Seen {
+                machine: self.name.clone(),
+            }))
+            .await;
     }
 
     /// Locks the machine out for `fault` (once, until a clear) and tells the daemon.
