@@ -10,7 +10,7 @@ Exit codes:
   0    done; for teach and inspect: the job ran to its end and (inspect) the part is within its tolerance
   1    the command failed (the daemon refused it, a file could not be read, the daemon could not be reached)
   2    usage: an unknown command or option, or an option's value out of range
-  3    configuration: the station file (or a simulator file) cannot be read or is invalid
+  3    configuration: the station file, a part file or a simulator file cannot be read or is invalid
   4    inspect: the part was measured and is outside its tolerance (the report is written)
   5    teach or inspect: the job was aborted (`zeroset abort`)
   6    teach or inspect: the job stopped on a fault and waits for `zeroset clear`; follow it with `zeroset watch`

@@ -10,7 +10,7 @@ use super::control::{accepted, Control};
 use super::exit::JobEnded;
 use super::watch::{JobEnd, Watch};
 use crate::api::{JobKind, JobPhase, Reply, Request, StationStatus, Verdict};
-use crate::config::StationConfig;
+use crate::config::{PartConfig, StationConfig};
 
 /// The station file, shared by every station command.
 #[derive(Debug, Args, Clone)]
@@ -165,6 +165,12 @@ fn init_logging(folder: &Path) -> anyhow::Result<()> {
 /// `zeroset teach` and `zeroset inspect`: starts the job and, unless detached, shows it live to its end. Returns
 /// the inspection's verdict (`None` for a teach or a detached job); an abort or a stop is [`JobEnded`].
 pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<Option<Verdict>> {
+    if let Request::Teach { part } | Request::Inspect { part, .. } = &request {
+        // The daemon reads the part file too; reading it here first makes a broken one the configuration error
+        // it is (exit code 3, with the file's own message), before anything is asked of the station.
+        let config = StationConfig::load(&job.station.config)?;
+        PartConfig::load(&config.part_path(part))?;
+    }
     // Subscribed before the job starts, so that none of its events are missed.
     let events = if job.detach {
         None

@@ -145,20 +145,38 @@ fn inspect_exits_4_for_a_failing_part_and_0_for_a_passing_one_and_watch_waits_fo
     watch.until_line(10, "no job is running; waiting for the next one");
     drop(watch);
 
-    // A part file whose name is not its file's is refused, naming both.
+    // A part file whose name is not its file's is refused, naming both: a configuration error (exit code 3).
     std::fs::copy(
         parts.path().join("propeller.toml"),
         parts.path().join("blade.toml"),
     )
     .unwrap();
     let run = station.cli(&["teach", "blade"]);
-    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert_eq!(run.code, Some(3), "{}", run.stderr);
     assert!(
         run.stderr
             .contains("name = \"propeller\" but the file is named blade.toml"),
         "{}",
         run.stderr
     );
+    // So is a part file that is not TOML, and a part with no file, each named.
+    std::fs::write(
+        parts.path().join("broken.toml"),
+        "name = \"broken\"\ninstances = [\n",
+    )
+    .unwrap();
+    for part in ["broken", "missing"] {
+        let run = station.cli(&["inspect", part, "--serial", "SN-X"]);
+        assert_eq!(run.code, Some(3), "{part}: {}", run.stderr);
+        assert!(
+            run.stderr.starts_with(&format!(
+                "error: {}",
+                parts.path().join(format!("{part}.toml")).display()
+            )),
+            "{part}: {}",
+            run.stderr
+        );
+    }
 
     propeller_part(parts.path(), -1.5, 1.5);
     let run = station.cli(&["inspect", "propeller", "--serial", "SN-PASS"]);
