@@ -51,6 +51,17 @@ const HEADER_HELP: &str = "expected a header of y,z (a profile) or x,y,z (3-D po
 
 /// Reads a point file.
 pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
+    read_point_file(path).map(|file| file.points)
+}
+
+/// A point file's points and, for each, the line of the file it is on (to name a point to the operator).
+pub struct PointFile {
+    pub points: PointSet,
+    pub lines: Vec<u64>,
+}
+
+/// Reads a point file, keeping each point's line.
+pub fn read_point_file(path: &Path) -> Result<PointFile, PointFileError> {
     let table = read_table(path, |header| {
         if let Some(unknown) = header.iter().find(|c| !["x", "y", "z"].contains(c)) {
             let hint = if *unknown == SEGMENT_COLUMN {
@@ -66,12 +77,17 @@ pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
         }
     })?;
     let spatial = table.header.len() == 3;
+    let lines = table
+        .rows
+        .iter()
+        .map(|(line, _)| line.unwrap_or_default())
+        .collect();
     let rows = table
         .rows
         .iter()
         .map(|(line, record)| table.coordinates(*line, record, table.header.len()))
         .collect::<Result<Vec<Vec<f64>>, _>>()?;
-    Ok(if spatial {
+    let points = if spatial {
         PointSet::Spatial(
             rows.iter()
                 .map(|r| Vector3::new(r[0], r[1], r[2]))
@@ -79,7 +95,8 @@ pub fn read_points(path: &Path) -> Result<PointSet, PointFileError> {
         )
     } else {
         PointSet::Profile(rows.iter().map(|r| Vector2::new(r[0], r[1])).collect())
-    })
+    };
+    Ok(PointFile { points, lines })
 }
 
 /// The column that names the segment of a part a point belongs to (seed 001 section 6.3: a segmented scan).
@@ -215,8 +232,17 @@ fn parse_coordinate(field: &str, column: &str) -> Result<f64, String> {
     if !value.is_finite() {
         return Err(format!("column {column}: '{field}' is not a finite number"));
     }
+    if value.abs() > REACH_MM {
+        return Err(format!(
+            "column {column}: {field} mm is beyond any measuring machine's reach ({REACH_MM} mm); a unit or \
+             export error? correct or remove the line"
+        ));
+    }
     Ok(value)
 }
+
+/// No coordinate measuring machine reaches farther than this from its origin (mm): 100 m.
+const REACH_MM: f64 = 1e5;
 
 #[cfg(test)]
 mod tests {
@@ -254,6 +280,15 @@ mod tests {
             read("y,z\n1,NaN\n").unwrap_err(),
             "DIR/points.csv: line 2: column z: 'NaN' is not a finite number"
         );
+        // A value no machine can measure names its line (it used to make the whole file "a straight line").
+        let far = read("y,z\n1,2\n3,4\n1e30,5\n").unwrap_err();
+        assert!(
+            far.starts_with(
+                "DIR/points.csv: line 4: column y: 1e30 mm is beyond any measuring machine's reach"
+            ),
+            "{far}"
+        );
+        assert!(read("y,z\n-99999,2\n").is_ok(), "100 m is within reach");
         assert_eq!(
             read("y,w\n1,2\n").unwrap_err(),
             "DIR/points.csv: line 1: unknown column 'w' (expected a header of y,z (a profile) or x,y,z (3-D points), in mm)"

@@ -6,6 +6,7 @@
 
 pub mod deviation;
 pub mod edges;
+pub(crate) mod fit_sanity;
 mod nominals;
 pub mod part_mesh;
 pub mod reference;

@@ -350,11 +350,11 @@ fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackPro
     }
     let fitted = best.expect("the configured degree was fitted or its error returned");
     let stats = &fitted.stats;
-    if stats.zero_set_components > 1 || stats.side_segments_crossed_again > 0 {
+    if stats.branches_beside_data > 0 || stats.side_segments_crossed_again > 0 {
         tracing::warn!(
             profile = %name,
             x_mm,
-            zero_set_components = stats.zero_set_components,
+            branches_beside_data = stats.branches_beside_data,
             side_segments_crossed_again = stats.side_segments_crossed_again,
             "the reference profile's model has a spurious branch or sliver near the data; deviations near it \
              may be wrong: check them, or teach again with another degree or method"

@@ -221,6 +221,10 @@ pub struct ProfileFit {
     pub points: usize,
     pub rms_mm: Option<f64>,
     pub max_mm: Option<f64>,
+    /// What the fit's statistics say against the data and the part's tolerance: each doubt with its reason and
+    /// what to try (none for a fit that models its data).
+    #[serde(default)]
+    pub doubts: Vec<String>,
 }
 
 /// One instance's result.

@@ -17,7 +17,7 @@ use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{stack_of, ModelFile, ReferenceModel};
-use crate::points::{read_points, PointSet};
+use crate::points::{read_point_file, PointSet};
 
 /// Zero-set sampling for exact-distance seeds: cells along the longest side of twice the model's data box.
 const PROFILE_CELLS: usize = 512;
@@ -41,7 +41,8 @@ pub struct DeviateArgs {
 pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let file = ModelFile::load(&args.model)?;
-    let points = read_points(&args.points)?;
+    let point_file = read_point_file(&args.points)?;
+    let points = &point_file.points;
     let method: DistanceMethod = args.distance.into();
     let mismatch = |model: &str, wants: &str, has: &str| {
         anyhow!(
@@ -51,15 +52,21 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
         )
     };
     let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) =
-        match (&file.model, &points) {
-            (ReferenceModel::Profile(m), PointSet::Profile(p)) => (
-                coordinates(p),
-                distances_to(&m.ip, &m.domain.scaled(2.0), PROFILE_CELLS, p, method),
-            ),
-            (ReferenceModel::Surface(m), PointSet::Spatial(p)) => (
-                coordinates(p),
-                distances_to(&m.ip, &m.domain.scaled(2.0), SURFACE_CELLS, p, method),
-            ),
+        match (&file.model, points) {
+            (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
+                let range = m.domain.scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    distances_to(&m.ip, &range, PROFILE_CELLS, p, method)
+                });
+                (coordinates(p), distances)
+            }
+            (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
+                let range = m.domain.scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    distances_to(&m.ip, &range, SURFACE_CELLS, p, method)
+                });
+                (coordinates(p), distances)
+            }
             (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
                 let stack =
                     stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
@@ -67,13 +74,16 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
                 let mut sorted = profiles.clone();
                 sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
                 let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
-                let reach = 4.0 * stack.bounds(&domains).diagonal();
-                let distances = signed_distances(&stack, p, method, reach, |points| {
-                    let exact = StackDistance::new(&stack, &domains);
-                    points
-                        .iter()
-                        .map(|q| exact.foot(q).map(|f| f.distance))
-                        .collect()
+                let range = stack.bounds(&domains).scaled(RANGE);
+                let reach = 2.0 * range.diagonal();
+                let distances = within(&range, p, |p| {
+                    signed_distances(&stack, p, method, reach, |points| {
+                        let exact = StackDistance::new(&stack, &domains);
+                        points
+                            .iter()
+                            .map(|q| exact.foot(q).map(|f| f.distance))
+                            .collect()
+                    })
                 });
                 (coordinates(p), distances)
             }
@@ -86,15 +96,22 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
                     );
                 }
                 let exact = SolidDistance::new(solid);
-                let distances = p
-                    .iter()
-                    .map(|q| {
-                        exact
-                            .foot(&nalgebra::Point3::from(*q))
-                            .map(|f| f.distance_mm)
-                            .ok_or(DistanceError::NoFootPoint)
-                    })
-                    .collect();
+                let bounds = solid.bounds();
+                let range = Aabb {
+                    min: bounds.min.coords,
+                    max: bounds.max.coords,
+                }
+                .scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    p.iter()
+                        .map(|q| {
+                            exact
+                                .foot(&nalgebra::Point3::from(*q))
+                                .map(|f| f.distance_mm)
+                                .ok_or(DistanceError::NoFootPoint)
+                        })
+                        .collect()
+                });
                 (coordinates(p), distances)
             }
             (ReferenceModel::Profile(_), PointSet::Spatial(_)) => {
@@ -109,6 +126,7 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     };
     write_csv(&args.out, header, &rows, &distances)?;
     print_summary(&args.points, &file, method, &distances);
+    name_points_out_of_range(&point_file.lines, &distances);
     if distances.iter().all(Result::is_err) {
         anyhow::bail!(
             "{}: no point has a deviation from {} (see the status column of {})",
@@ -123,6 +141,53 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// A model answers for the region it was fitted in: its data's box (the solid's box, for a supershape) with every
+/// side doubled, where the zero set is sampled. A point beyond it is not measured: a distance taken from a
+/// polynomial extrapolated a kilometre out is a number, not a deviation, and would swamp the statistics.
+const RANGE: f64 = 2.0;
+
+/// Measures the points within `range` by `measure`; the others are [`DistanceError::OutsideModelRange`].
+fn within<const N: usize>(
+    range: &Aabb<N>,
+    points: &[SVector<f64, N>],
+    measure: impl FnOnce(&[SVector<f64, N>]) -> Vec<Result<f64, DistanceError>>,
+) -> Vec<Result<f64, DistanceError>> {
+    let inside = |p: &SVector<f64, N>| (0..N).all(|k| p[k] >= range.min[k] && p[k] <= range.max[k]);
+    let measured: Vec<SVector<f64, N>> = points.iter().copied().filter(inside).collect();
+    let mut distances = measure(&measured).into_iter();
+    points
+        .iter()
+        .map(|p| {
+            if inside(p) {
+                distances.next().unwrap_or(Err(DistanceError::NoFootPoint))
+            } else {
+                Err(DistanceError::OutsideModelRange)
+            }
+        })
+        .collect()
+}
+
+/// The lines of the points left unmeasured for being outside the model's range, so the operator can find them.
+fn name_points_out_of_range(lines: &[u64], distances: &[Result<f64, DistanceError>]) {
+    let outside: Vec<String> = distances
+        .iter()
+        .zip(lines)
+        .filter(|(d, _)| matches!(d, Err(DistanceError::OutsideModelRange)))
+        .map(|(_, line)| line.to_string())
+        .collect();
+    if outside.is_empty() {
+        return;
+    }
+    let shown = outside.len().min(10);
+    let more = if outside.len() > shown { ", ..." } else { "" };
+    println!(
+        "  warning: {} point(s) lie far outside the model's range (its data's box, doubled) and were not measured \
+         (line {}{more}): points of another part, or a unit or export error?",
+        outside.len(),
+        outside[..shown].join(", ")
+    );
 }
 
 fn coordinates<const N: usize>(points: &[SVector<f64, N>]) -> Vec<Vec<f64>> {

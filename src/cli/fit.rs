@@ -8,11 +8,12 @@ use clap::{Args, ValueEnum};
 use nalgebra::{SVector, Vector2, Vector3};
 
 use super::{all_rows, MethodArg};
+use crate::analysis::fit_sanity;
 use crate::geometry::fit3l::{fit_ip, FitOptions, Fitted};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
 use crate::model_file::{FittedIp, ModelFile, ReferenceModel, StackProfile};
-use crate::points::{read_points, PointSet};
+use crate::points::{read_point_file, PointFile, PointSet};
 
 #[derive(Args)]
 pub struct FitIpArgs {
@@ -34,9 +35,24 @@ pub struct FitIpArgs {
     /// Points whose x differ by less than this (mm) belong to the same profile plane (with --stack).
     #[arg(long, default_value_t = 1.0)]
     plane_tolerance: f64,
+    /// The part's tolerance, mm (the half width of its band): warn when a fitted point lies farther than this
+    /// from the model, which could not then measure the part to it.
+    #[arg(long, value_parser = tolerance)]
+    tolerance: Option<f64>,
     /// The model file to write (JSON).
     #[arg(long)]
     out: PathBuf,
+}
+
+/// `--tolerance`: a positive length in mm.
+fn tolerance(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(t) if t.is_finite() && t > 0.0 => Ok(t),
+        Ok(t) => Err(format!(
+            "{t} mm is not a tolerance; give a positive number of mm"
+        )),
+        Err(e) => Err(format!("{e}; give a positive number of mm")),
+    }
 }
 
 /// `--degree`: checked as an option, so that a degree out of range is a usage error, not a fault of the file.
@@ -63,12 +79,13 @@ enum NormalsArg {
 
 pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let points = read_points(&args.points)?;
+    let file = read_point_file(&args.points)?;
+    warn_of_isolated_points(&file);
     let options = FitOptions::new(args.degree, args.method.into());
-    let (model, method) = match (points, args.stack) {
+    let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) => {
             let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
-            print_fit(&args.points, "profile", &fitted);
+            print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
             (
                 ReferenceModel::Profile(into_file(fitted.clone())),
                 fitted.method,
@@ -84,7 +101,8 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             let normals = pca_normals(&points);
             let fitted = fit_ip(&points, &normals, &options)
                 .map_err(|e| anyhow!("{}: {e}", all_rows(&args.points, points.len())))?;
-            print_fit(&args.points, "surface", &fitted);
+            print_fit(&args.points, "surface", &fitted, &points, args.tolerance);
+            warn_if_profiles(&points, args.plane_tolerance);
             (
                 ReferenceModel::Surface(into_file(fitted.clone())),
                 fitted.method,
@@ -187,7 +205,13 @@ fn fit_stack(
         let yz: Vec<Vector2<f64>> = plane.iter().map(|p| Vector2::new(p.y, p.z)).collect();
         let fitted = fit_profile(path, &yz, options, args.normals)
             .with_context(|| format!("the profile at x = {x:.3} mm"))?;
-        print_fit(path, &format!("profile at x = {x:.3} mm"), &fitted);
+        print_fit(
+            path,
+            &format!("profile at x = {x:.3} mm"),
+            &fitted,
+            &yz,
+            args.tolerance,
+        );
         profiles.push(StackProfile {
             x,
             fitted: into_file(fitted),
@@ -222,7 +246,14 @@ fn group_into_planes(points: &[Vector3<f64>], tolerance: f64) -> Vec<(f64, Vec<V
         .collect()
 }
 
-fn print_fit<const N: usize>(path: &Path, what: &str, fitted: &Fitted<N>) {
+/// The fit's statistics, and each doubt they raise about it (see [`fit_sanity::doubts`]).
+fn print_fit<const N: usize>(
+    path: &Path,
+    what: &str,
+    fitted: &Fitted<N>,
+    points: &[SVector<f64, N>],
+    tolerance_mm: Option<f64>,
+) {
     let s = &fitted.stats;
     let at: Vec<String> = s
         .max_distance_at
@@ -247,27 +278,57 @@ fn print_fit<const N: usize>(path: &Path, what: &str, fitted: &Fitted<N>) {
         s.condition_number, s.offset_min_mm, s.offset_max_mm, s.refinement_iterations
     );
     println!(
-        "  zero set: {} component(s) within twice the data's box",
-        s.zero_set_components
+        "  zero set: {} component(s) within twice the data's box, {} spurious branch(es) beside the data",
+        s.zero_set_components, s.branches_beside_data
     );
-    if s.zero_set_components > 1 {
-        println!(
-            "  warning: the model has {} zero-set components near the data: a spurious branch; check deviations \
-             near it, or try another degree or method",
-            s.zero_set_components
-        );
+    let scatter = fit_sanity::scatter_mm(points);
+    for doubt in fit_sanity::doubts(s, scatter, &fitted.domain, tolerance_mm) {
+        println!("  warning: {doubt}");
     }
-    if s.side_segments_crossed_again > 0 {
-        println!(
-            "  warning: the model's zero set crosses {} of {} short segments across the data more than once: \
-             a sliver of spurious surface beside the data, where deviations may have the wrong sign",
-            s.side_segments_crossed_again, s.side_segments
-        );
+}
+
+/// Points that stand far from all others are named by their lines before the fit: an export error, or a touch of
+/// something else, pulls the whole model.
+fn warn_of_isolated_points(file: &PointFile) {
+    let isolated = match &file.points {
+        PointSet::Profile(points) => fit_sanity::isolated_points(points),
+        PointSet::Spatial(points) => fit_sanity::isolated_points(points),
+    };
+    if isolated.is_empty() {
+        return;
     }
-    if s.points_without_foot > 0 {
+    let lines: Vec<String> = isolated
+        .iter()
+        .take(10)
+        .map(|&i| file.lines[i].to_string())
+        .collect();
+    let more = if isolated.len() > 10 { ", ..." } else { "" };
+    println!(
+        "warning: {} point(s) stand far from all the others (line {}{more}): an export error or a touch of \
+         something else? remove them and fit again",
+        isolated.len(),
+        lines.join(", ")
+    );
+}
+
+/// 3-D points fitted as one surface that lie in parallel planes of constant x are profiles: say so, and that
+/// `--stack` fits them as such.
+fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) {
+    let planes = group_into_planes(points, plane_tolerance);
+    let profiles = planes.len() >= 2
+        && planes
+            .iter()
+            .all(|(_, plane)| plane.len() >= MIN_PROFILE_POINTS);
+    if profiles {
+        let xs: Vec<String> = planes.iter().map(|(x, _)| format!("{x:.3}")).collect();
         println!(
-            "  warning: {} fitted points have no foot point on the model",
-            s.points_without_foot
+            "  warning: the points lie in {} parallel planes of constant x (x = {} mm): they are profiles, \
+             which one surface does not model; fit them with --stack",
+            planes.len(),
+            xs.join(", ")
         );
     }
 }
+
+/// A plane of constant x holding at least this many points is a scanned profile, not a scatter of surface points.
+const MIN_PROFILE_POINTS: usize = 10;

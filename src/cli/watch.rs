@@ -155,6 +155,9 @@ impl Watch {
                         _ => "no fit distances kept by this reference kind".to_string(),
                     };
                     self.line(format!("  {}: {} points, {distance}", fit.profile, fit.points))?;
+                    for doubt in &fit.doubts {
+                        self.line(format!("    warning: {doubt}"))?;
+                    }
                 }
                 return Ok(Some(JobEnd::Finished { verdict: None }));
             }

@@ -104,6 +104,10 @@ impl FitOptions {
     }
 }
 
+/// How near a spurious branch must come to the data to be reported, as a fraction of the data box's diagonal:
+/// 2 mm for a 100 mm section, farther than a measured point of a part in tolerance strays from its model.
+pub const BESIDE_DATA: f64 = 0.02;
+
 /// How good a fit is, in millimetres; returned with every model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitStats {
@@ -118,6 +122,10 @@ pub struct FitStats {
     /// Connected components of the zero set inside twice the data's bounding box: 1 for a clean closed profile;
     /// more means a spurious branch near the data.
     pub zero_set_components: usize,
+    /// Of those, the spurious branches beside the data: components no fitted point lies nearest to that come
+    /// within [`BESIDE_DATA`] of the data's box diagonal of a fitted point. Only these can change a deviation.
+    #[serde(default)]
+    pub branches_beside_data: usize,
     /// The range of 3L offsets used, mm.
     pub offset_min_mm: f64,
     pub offset_max_mm: f64,
@@ -631,6 +639,7 @@ fn measure<const N: usize>(
         max_distance_at: max.1.iter().copied().collect(),
         condition_number: f64::NAN,
         zero_set_components: samples.components(),
+        branches_beside_data: samples.branches_beside(points, BESIDE_DATA * domain.diagonal()),
         offset_min_mm: 0.0,
         offset_max_mm: 0.0,
         refinement_iterations: 0,

@@ -57,6 +57,8 @@ pub struct ZeroSetSamples<const N: usize> {
     coarse: usize,
     index: PointIndex<N>,
     components: usize,
+    /// The component of each grid sample (`points[..coarse]`).
+    component_of: Vec<usize>,
     cell_size: f64,
 }
 
@@ -80,15 +82,16 @@ impl<const N: usize> ZeroSetSamples<N> {
         };
         let signs = grid.corner_signs(f);
         let crossing = grid.crossing_cells(&signs);
-        let components = grid.count_components(&crossing);
-        let mut points: Vec<_> = crossing
+        let (components, cell_component) = grid.label_components(&crossing);
+        let (mut points, component_of): (Vec<_>, Vec<usize>) = crossing
             .iter()
             .enumerate()
             .filter(|(_, &c)| c)
             .filter_map(|(index, _)| {
                 project_to_zero_set(f, &grid.cell_center(index), 1.5 * cell.norm())
+                    .map(|p| (p, cell_component[index]))
             })
-            .collect();
+            .unzip();
         let coarse = points.len();
         // Surfaces are not refined: a 3-D block at the resolution that helps is thousands of evaluations of a
         // polynomial with hundreds of terms per sample, which made a stack's distances take a minute.
@@ -101,6 +104,7 @@ impl<const N: usize> ZeroSetSamples<N> {
             coarse,
             index,
             components,
+            component_of,
             cell_size,
         }
     }
@@ -113,6 +117,34 @@ impl<const N: usize> ZeroSetSamples<N> {
     /// Connected components of the zero set inside the box (cells joined through shared faces).
     pub fn components(&self) -> usize {
         self.components
+    }
+
+    /// Components that no point of `data` lies nearest to but that come within `near` of one: spurious branches
+    /// beside the data, where a measured point off the part may find its foot on the wrong curve. A branch far
+    /// out in the box, which no measured point reaches, is not counted: it changes no deviation.
+    pub fn branches_beside(&self, data: &[SVector<f64, N>], near: f64) -> usize {
+        let grid_samples = &self.points[..self.coarse];
+        if grid_samples.is_empty() || data.is_empty() {
+            return 0;
+        }
+        let samples = PointIndex::new(grid_samples);
+        let mut carries = vec![false; self.components];
+        for p in data {
+            if let Some(i) = samples.nearest(p) {
+                carries[self.component_of[i]] = true;
+            }
+        }
+        let data_index = PointIndex::new(data);
+        let mut closest = vec![f64::INFINITY; self.components];
+        for (sample, &component) in grid_samples.iter().zip(&self.component_of) {
+            if carries[component] {
+                continue;
+            }
+            if let Some(j) = data_index.nearest(sample) {
+                closest[component] = closest[component].min((data[j] - sample).norm());
+            }
+        }
+        closest.iter().filter(|&&d| d <= near).count()
     }
 
     pub fn points(&self) -> &[SVector<f64, N>] {
@@ -279,7 +311,9 @@ impl<const N: usize> Grid<N> {
             .collect()
     }
 
-    fn count_components(&self, crossing: &[bool]) -> usize {
+    /// The number of connected components among the crossing cells, and each cell's component (0 for cells
+    /// that do not cross).
+    fn label_components(&self, crossing: &[bool]) -> (usize, Vec<usize>) {
         let mut sets = DisjointSets::new(crossing.len());
         for cell in (0..crossing.len()).filter(|&c| crossing[c]) {
             let idx = unflatten(cell, &self.counts);
@@ -294,9 +328,18 @@ impl<const N: usize> Grid<N> {
                 }
             }
         }
-        (0..crossing.len())
-            .filter(|&c| crossing[c] && sets.find(c) == c)
-            .count()
+        let mut label_of_root = std::collections::HashMap::new();
+        let labels = (0..crossing.len())
+            .map(|c| {
+                if !crossing[c] {
+                    return 0;
+                }
+                let root = sets.find(c);
+                let next = label_of_root.len();
+                *label_of_root.entry(root).or_insert(next)
+            })
+            .collect();
+        (label_of_root.len(), labels)
     }
 
     fn cell_center(&self, cell: usize) -> SVector<f64, N> {

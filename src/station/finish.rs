@@ -5,11 +5,14 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use nalgebra::Vector2;
+
 use super::job::job_scans;
 use super::journal::{file_stem, JobDir, JobRecord};
 use super::pipeline::scan_ref;
 use crate::analysis::compensate_scan;
 use crate::analysis::deviation::ProfileGauge;
+use crate::analysis::fit_sanity;
 use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
@@ -77,7 +80,13 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
             .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
     }
     reference.save(path).map_err(|e| e.to_string())?;
-    let fits = reference_fits(&reference, &profiles);
+    let band = plan.tolerance();
+    let fits = reference_fits(&reference, &profiles, band.upper_mm.min(-band.lower_mm));
+    for fit in &fits {
+        for doubt in &fit.doubts {
+            tracing::warn!(part = plan.part(), profile = %fit.profile, doubt = %doubt, "teach: the reference fit is doubtful");
+        }
+    }
     Ok(Outcome::Taught {
         path: path.to_path_buf(),
         profiles: fits,
@@ -85,25 +94,49 @@ pub fn fit_reference(plan: &Plan, dir: &JobDir, path: &Path) -> Result<Outcome, 
 }
 
 /// How closely the reference follows each master profile: a stack's own fit statistics, or the exact distances
-/// of each profile's points to the solid.
-fn reference_fits(reference: &Reference, profiles: &[MasterProfile]) -> Vec<ProfileFit> {
+/// of each profile's points to the solid; with the doubts they raise against the part's tolerance `tolerance_mm`
+/// (the half width of its band).
+fn reference_fits(
+    reference: &Reference,
+    profiles: &[MasterProfile],
+    tolerance_mm: f64,
+) -> Vec<ProfileFit> {
     let fit = |master: &MasterProfile, rms_mm: Option<f64>, max_mm: Option<f64>| ProfileFit {
         profile: master.name.clone(),
         points: master.points.len(),
         rms_mm,
         max_mm,
+        doubts: max_mm
+            .and_then(|max| fit_sanity::beyond_tolerance(max, &[], tolerance_mm))
+            .into_iter()
+            .collect(),
     };
     match &reference.model.model {
         ReferenceModel::Stack { profiles: fitted } => fitted
             .iter()
             .zip(profiles)
-            .map(|(stack, master)| {
-                let stats = stack.fitted.fit.as_ref();
-                fit(
-                    master,
-                    stats.map(|s| s.rms_distance_mm),
-                    stats.map(|s| s.max_distance_mm),
-                )
+            .map(|(stack, master)| match stack.fitted.fit.as_ref() {
+                Some(stats) => {
+                    let in_plane: Vec<Vector2<f64>> = master
+                        .points
+                        .iter()
+                        .map(|p| Vector2::new(p.y, p.z))
+                        .collect();
+                    ProfileFit {
+                        doubts: fit_sanity::doubts(
+                            stats,
+                            fit_sanity::scatter_mm(&in_plane),
+                            &stack.fitted.domain,
+                            Some(tolerance_mm),
+                        ),
+                        ..fit(
+                            master,
+                            Some(stats.rms_distance_mm),
+                            Some(stats.max_distance_mm),
+                        )
+                    }
+                }
+                None => fit(master, None, None),
             })
             .collect(),
         ReferenceModel::Supershape { solid, .. } => {

@@ -6,6 +6,7 @@ mod daemon;
 mod errors;
 mod fault_campaign;
 mod fit_and_deviate;
+mod fit_sanity;
 mod lockout;
 mod lost_points;
 mod machine_link;

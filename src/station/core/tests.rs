@@ -379,6 +379,7 @@ fn clear_resumes_a_stopped_job_where_it_stopped_and_the_job_then_finishes() {
                 points: 391,
                 rms_mm: Some(0.002),
                 max_mm: None,
+                doubts: Vec::new(),
             }],
         }),
     });
