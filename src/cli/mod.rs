@@ -19,6 +19,7 @@ macro_rules! out {
 mod control;
 pub mod demo;
 mod deviate;
+mod evaluate;
 pub mod exit;
 mod fit;
 mod fit_supershape;
@@ -71,6 +72,9 @@ enum Command {
     Fit(FitCommand),
     /// Signed deviations (mm, positive outside the material) of measured points from a reference model.
     Deviate(deviate::DeviateArgs),
+    /// Where a measured section lies against its nominal profile model (shift along the chord and the thickness,
+    /// twist, in mm and deg) and its form error after a least-squares or minimum-zone best fit.
+    Evaluate(evaluate::EvaluateArgs),
     /// Polygonise a supershape model into a closed mesh (STL, PLY or OBJ by the file's extension).
     Mesh(mesh::MeshArgs),
     /// The clearance of every move of a taught part's inspection (mm) and the silhouette of the swept ball (SVG).
@@ -141,6 +145,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
         Command::Fit(FitCommand::Supershape(args)) => fit_supershape::run(&args),
         Command::Deviate(args) => deviate::run(&args),
+        Command::Evaluate(args) => evaluate::run(&args),
         Command::Mesh(args) => mesh::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         Command::Sim(args) => zeroset_sim::cli::run(&args),

@@ -10,6 +10,7 @@ pub mod normals;
 pub mod poly;
 pub mod published;
 pub mod sampling;
+pub(crate) mod section_fit;
 pub mod small;
 pub mod supershape;
 pub mod sweep;

@@ -4,6 +4,7 @@
 mod campaign;
 mod daemon;
 mod errors;
+mod evaluate;
 mod fault_campaign;
 mod fit_and_deviate;
 mod fit_sanity;

@@ -1,0 +1,77 @@
+//! `zeroset evaluate`: a section moved rigidly off its nominal reads back as that motion, and its form as the
+//! noise left once the motion is removed; the minimum zone is never wider than least squares'.
+
+use crate::support::{config, fit_ip, zeroset_ok};
+
+/// The numbers of `line` after `marker`, up to `count`.
+fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
+    let line = printed
+        .lines()
+        .find(|l| l.contains(marker))
+        .unwrap_or_else(|| panic!("no '{marker}' in:\n{printed}"));
+    let rest = &line[line.find(marker).unwrap() + marker.len()..];
+    rest.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+'))
+        .filter_map(|s| s.parse::<f64>().ok())
+        .take(count)
+        .collect()
+}
+
+#[test]
+fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("a.json");
+    let blade = config("profiles/seed003-profile3-blade-a.csv");
+    fit_ip(&blade, &[], &model);
+    // The master's own points, 0.4 mm lower and 0.05 mm to +y: what a blade shifted on the hub would measure.
+    let text = std::fs::read_to_string(&blade).unwrap();
+    let mut moved = String::from("y,z\n");
+    for line in text.lines().skip(1) {
+        let (y, z) = line.split_once(',').unwrap();
+        let (y, z): (f64, f64) = (y.parse().unwrap(), z.parse().unwrap());
+        moved.push_str(&format!("{},{}\n", y + 0.05, z - 0.4));
+    }
+    let section = dir.path().join("moved.csv");
+    std::fs::write(&section, moved).unwrap();
+    let mut zones = Vec::new();
+    for method in ["l2", "minzone"] {
+        let out = dir.path().join(format!("{method}.csv"));
+        let printed = zeroset_ok(&[
+            "evaluate",
+            "--model",
+            model.to_str().unwrap(),
+            "--points",
+            section.to_str().unwrap(),
+            "--method",
+            method,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let chord = numbers_after(&printed, "chord direction (y, z)", 2);
+        let shift = numbers_after(&printed, "the section lies", 2);
+        let (dn, dchord) = (shift[0], shift[1]);
+        let (along, across) = ((chord[0], chord[1]), (-chord[1], chord[0]));
+        let dy = dchord * along.0 + dn * across.0;
+        let dz = dchord * along.1 + dn * across.1;
+        // The model follows the master within its 2 um noise: the motion is read within 3 um.
+        assert!(
+            (dy - 0.05).abs() < 0.003 && (dz + 0.4).abs() < 0.003,
+            "{method}: read ({dy}, {dz}) mm:\n{printed}"
+        );
+        let turned = numbers_after(&printed, "nominal, turned", 1)[0];
+        assert!(turned.abs() < 0.003, "{method}: {turned} deg\n{printed}");
+        let before = numbers_after(&printed, "as measured:", 4);
+        let after = numbers_after(&printed, "after the fit:", 4);
+        assert!(before[3] > 0.7, "as measured the 0.4 mm shows: {printed}");
+        assert!(after[2] < 0.003 && after[3] < 0.02, "{method}: {printed}");
+        zones.push(after[3]);
+        let written = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(written.lines().count(), 401);
+        assert!(written.starts_with("y,z,deviation_mm,after_fit_mm\n"));
+    }
+    assert!(
+        zones[1] <= zones[0] + 1e-4,
+        "minimum zone {} mm, L2 {} mm",
+        zones[1],
+        zones[0]
+    );
+}
