@@ -60,6 +60,7 @@ fn profile(blade: usize, x: f64, shift: f64) -> ProfileReport {
         scanned_at: "2026-11-23T10:00:00Z".into(),
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
+        best_fits: Vec::new(),
         points,
     }
 }

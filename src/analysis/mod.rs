@@ -10,6 +10,7 @@ pub(crate) mod fit_sanity;
 mod nominals;
 pub mod part_mesh;
 pub mod reference;
+pub mod section;
 pub mod stats;
 #[cfg(test)]
 pub(crate) mod test_profiles;

@@ -7,6 +7,7 @@ use anyhow::{anyhow, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::Vector2;
 
+use crate::analysis::section::chord_of;
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
 use crate::geometry::implicit::Implicit;
@@ -111,27 +112,6 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         println!("wrote {}", out.display());
     }
     Ok(())
-}
-
-/// The section's chord: the middle and direction of its two points farthest apart (nose and tail), the direction
-/// pointing to +y (to +z for a chord along z). Taken from the measured points, which lie within the section's
-/// displacement of the nominal's: the direction differs by the twist, a second-order change in the components.
-fn chord_of(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) {
-    let mut best = (0.0, points[0], points[0]);
-    for (i, a) in points.iter().enumerate() {
-        for b in &points[i + 1..] {
-            let d = (a - b).norm_squared();
-            if d > best.0 {
-                best = (d, *a, *b);
-            }
-        }
-    }
-    let (_, a, b) = best;
-    let mut direction = (b - a).try_normalize(0.0).unwrap_or_else(Vector2::x);
-    if direction.x < 0.0 || (direction.x == 0.0 && direction.y < 0.0) {
-        direction = -direction;
-    }
-    ((a + b) / 2.0, direction)
 }
 
 fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>) {

@@ -98,9 +98,9 @@ pub(crate) enum SectionFitError {
 }
 
 /// Gauss-Newton steps before giving up.
-const MAX_STEPS: usize = 60;
-/// A step moving no point by more than this (mm) ends the fit.
-const SETTLED_MM: f64 = 1e-9;
+const MAX_STEPS: usize = 100;
+/// A step moving no point by more than this (mm, a nanometre) ends the fit.
+const SETTLED_MM: f64 = 1e-6;
 /// A minimum-zone step narrowing the band by less than this (mm) is no step.
 const ZONE_GAIN_MM: f64 = 1e-11;
 
@@ -155,65 +155,72 @@ pub(crate) fn fit_section(
         .iter()
         .map(|m| m.distance_mm)
         .collect();
-    let mut motion = identity;
-    let mut measured = measure_all(&motion)?;
     let reach = points
         .iter()
         .map(|p| (p - pivot).norm())
         .fold(0.0, f64::max);
-    let mut settled = unknowns == 0;
-    for _ in 0..MAX_STEPS {
-        if settled {
-            break;
-        }
-        // Each row: how the point's distance changes with (shift x, shift y, angle) of the current motion.
-        let rows: Vec<(f64, Vector3<f64>)> = points
-            .iter()
-            .zip(&measured)
-            .map(|(p, m)| {
-                let arm = Rotation2::new(motion.angle) * (p - pivot);
-                let turn = Vector2::new(-arm.y, arm.x);
-                let row = Vector3::new(m.normal.x, m.normal.y, m.normal.dot(&turn));
-                (m.distance_mm, row)
-            })
-            .collect();
-        let step = match method {
-            FitMethod::L2 => l2_step(&rows, unknowns),
-            FitMethod::MinZone => minzone_step(&rows, unknowns, current_worst(&measured))?,
-        };
-        let moved_by = Vector2::new(step.x, step.y).norm() + step.z.abs() * reach;
-        if method == FitMethod::MinZone {
-            // The linear programme's step can overshoot where the normals turn, and where the optimum is
-            // degenerate (many points on the band at once) it may wander among equal answers: a step counts only
-            // if it narrows the zone, halved until it does; none that does ends the fit.
-            let worst = current_worst(&measured);
+    let mut motion = identity;
+    let mut measured = measure_all(&motion)?;
+    // The minimum zone starts from the least-squares fit: its linear programmes then only refine a motion that is
+    // already close, and the zone they end with can never be wider than least squares' band.
+    let stages: &[FitMethod] = match method {
+        FitMethod::L2 => &[FitMethod::L2],
+        FitMethod::MinZone => &[FitMethod::L2, FitMethod::MinZone],
+    };
+    for &stage in stages {
+        let mut settled = unknowns == 0;
+        // How far the minimum zone's linear programme may move a point (mm): it shrinks to the step last
+        // accepted when a step had to be halved, so that a poor linear model (the worst points at a sharp edge)
+        // ends in ever smaller steps, not in a zigzag.
+        let mut trust = 4.0 * current_worst(&measured).max(1e-6);
+        for _ in 0..MAX_STEPS {
+            if settled {
+                break;
+            }
+            // Each row: how the point's distance changes with (shift x, shift y, angle) of the current motion.
+            let rows: Vec<(f64, Vector3<f64>)> = points
+                .iter()
+                .zip(&measured)
+                .map(|(p, m)| {
+                    let arm = Rotation2::new(motion.angle) * (p - pivot);
+                    let turn = Vector2::new(-arm.y, arm.x);
+                    let row = Vector3::new(m.normal.x, m.normal.y, m.normal.dot(&turn));
+                    (m.distance_mm, row)
+                })
+                .collect();
+            let step = match stage {
+                FitMethod::L2 => l2_step(&rows, unknowns),
+                FitMethod::MinZone => minzone_step(&rows, unknowns, trust)?,
+            };
+            let moved_by = Vector2::new(step.x, step.y).norm() + step.z.abs() * reach;
+            // A step counts only if it improves the fit: the linear model is poor where the normals turn fast
+            // (a sharp edge, where the distance may switch to the edge's wedge), and where the minimum zone is
+            // degenerate (many points on the band at once) its programmes may wander among equal answers. A step
+            // that does not improve is halved until it does; none that does ends the fit.
+            let current = objective(stage, &measured);
             let mut trial = step;
+            let mut moved = moved_by;
             settled = true;
-            for _ in 0..30 {
+            for halving in 0..30 {
                 let candidate = Motion {
                     shift: motion.shift + Vector2::new(trial.x, trial.y),
                     angle: motion.angle + trial.z,
                 };
                 let next = measure_all(&candidate)?;
-                if current_worst(&next) < worst - ZONE_GAIN_MM {
+                if objective(stage, &next) < current - gain(stage, current) {
                     motion = candidate;
                     measured = next;
-                    settled = moved_by < SETTLED_MM;
+                    trust = if halving == 0 { 2.0 * trust } else { moved };
+                    settled = moved < SETTLED_MM;
                     break;
                 }
                 trial /= 2.0;
+                moved /= 2.0;
             }
-            continue;
         }
-        motion = Motion {
-            shift: motion.shift + Vector2::new(step.x, step.y),
-            angle: motion.angle + step.z,
-        };
-        measured = measure_all(&motion)?;
-        settled = moved_by < SETTLED_MM;
-    }
-    if !settled {
-        return Err(SectionFitError::NoConvergence(MAX_STEPS));
+        if !settled {
+            return Err(SectionFitError::NoConvergence(MAX_STEPS));
+        }
     }
     let after: Vec<f64> = measured.iter().map(|m| m.distance_mm).collect();
     // The fit maps measured onto nominal: the section itself is displaced by the inverse motion.
@@ -229,6 +236,22 @@ pub(crate) fn fit_section(
         before_mm: before,
         after_mm: after,
     })
+}
+
+/// What a stage minimises: the sum of squared deviations, or the largest absolute one.
+fn objective(stage: FitMethod, measured: &[Measured]) -> f64 {
+    match stage {
+        FitMethod::L2 => measured.iter().map(|m| m.distance_mm * m.distance_mm).sum(),
+        FitMethod::MinZone => current_worst(measured),
+    }
+}
+
+/// The least improvement of the objective that counts as one: the rounding of its sum, or of the zone.
+fn gain(stage: FitMethod, objective: f64) -> f64 {
+    match stage {
+        FitMethod::L2 => 1e-13 * objective,
+        FitMethod::MinZone => ZONE_GAIN_MM,
+    }
 }
 
 fn current_worst(measured: &[Measured]) -> f64 {
@@ -259,16 +282,14 @@ fn l2_step(rows: &[(f64, Vector3<f64>)], unknowns: usize) -> Vector3<f64> {
 }
 
 /// The step of the minimum zone: minimises t subject to -t <= d + row . step <= t for every point, a linear
-/// programme in the step and t; the step is bounded to a few times the current zone so that the linearisation
-/// holds.
+/// programme in the step and t; the step moves no point by more than `bound` (mm), where the linearisation holds.
 fn minzone_step(
     rows: &[(f64, Vector3<f64>)],
     unknowns: usize,
-    worst_mm: f64,
+    bound: f64,
 ) -> Result<Vector3<f64>, SectionFitError> {
     use microlp::{ComparisonOp, OptimizationDirection, Problem};
     let mut problem = Problem::new(OptimizationDirection::Minimize);
-    let bound = 4.0 * worst_mm.max(1e-6);
     let reach = rows
         .iter()
         .map(|(_, r)| r.z.abs())

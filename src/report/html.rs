@@ -42,6 +42,7 @@ fn report_html(report: &PartReport) -> Result<String, PlotError> {
     page.push_str(&header_html(report));
     page.push_str(&instance_table(report));
     page.push_str(&profile_table(report));
+    page.push_str(&best_fit_table(report));
     page.push_str(&figures_html(report)?);
     page.push_str("</body>\n</html>\n");
     Ok(page)
@@ -119,6 +120,46 @@ fn profile_table(report: &PartReport) -> String {
         })
     });
     table("Profiles", &["instance", "profile", "machine"], rows)
+}
+
+/// One row per instance and profile with a best fit: where the section lies and its form once that is removed,
+/// by least squares and by minimum zone.
+fn best_fit_table(report: &PartReport) -> String {
+    let mut html = String::from(
+        "<h2>Sections after a best fit (translations and twist about the chord's middle)</h2>\n<table>\n<tr>\
+         <th>instance</th><th>profile</th><th>method</th><th>along the thickness</th><th>along the chord</th>\
+         <th>shift (y, z)</th><th>twist</th><th>form min</th><th>form max</th><th>form RMS</th><th>zone</th></tr>\n",
+    );
+    for instance in &report.instances {
+        for profile in &instance.profiles {
+            for fit in &profile.best_fits {
+                let f = &fit.form;
+                let cells = [
+                    escape(&instance.name),
+                    escape(&profile.name),
+                    escape(&fit.method),
+                    deviation_mm(fit.dn_mm),
+                    deviation_mm(fit.dchord_mm),
+                    format!(
+                        "({:+.DEVIATION_DECIMALS$}, {:+.DEVIATION_DECIMALS$}) mm",
+                        fit.shift_mm[0], fit.shift_mm[1]
+                    ),
+                    format!("{:+.4} deg", fit.rotation_deg),
+                    deviation_mm(f.min_mm),
+                    deviation_mm(f.max_mm),
+                    format!("{:.DEVIATION_DECIMALS$} mm", f.rms_mm),
+                    format!("{:.DEVIATION_DECIMALS$} mm", f.zone_mm),
+                ];
+                html.push_str("<tr>");
+                for cell in cells {
+                    write!(html, "<td>{cell}</td>").expect("writing to a String");
+                }
+                html.push_str("</tr>\n");
+            }
+        }
+    }
+    html.push_str("</table>\n");
+    html
 }
 
 fn table(heading: &str, names: &[&str], rows: impl Iterator<Item = String>) -> String {

@@ -18,6 +18,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::section::SectionBestFit;
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
@@ -114,6 +115,10 @@ pub struct ProfileReport {
     pub scanned_at: String,
     pub stats: DeviationStats,
     pub verdict: Verdict,
+    /// The section's best fits to its reference (least squares, then minimum zone): where it lies, its twist and
+    /// its form once those are removed. Empty in older reports, or where the section could not be fitted.
+    #[serde(default)]
+    pub best_fits: Vec<SectionBestFit>,
     pub points: Vec<PointRecord>,
 }
 

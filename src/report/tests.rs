@@ -48,6 +48,7 @@ fn profile(
         scanned_at: "2025-03-04T10:11:12Z".to_string(),
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
+        best_fits: Vec::new(),
         points,
     };
     (report, stats, outside)

@@ -12,9 +12,9 @@ use super::journal::{file_stem, JobDir, JobRecord};
 use super::pipeline::scan_ref;
 use crate::analysis::compensate_scan;
 use crate::analysis::deviation::ProfileGauge;
-use crate::analysis::fit_sanity;
 use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
+use crate::analysis::{fit_sanity, section};
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
@@ -204,8 +204,12 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let compensated =
                 compensate_scan(&scan.points, radius, plan.plane_normal(key.instance));
             let mut flagged = 0;
+            let mut in_part = Vec::with_capacity(scan.points.len());
             for (raw, point) in scan.points.iter().zip(&compensated) {
                 let surface = point.surface;
+                if !point.is_flagged() {
+                    in_part.push(to_part * surface);
+                }
                 let measured = gauge.measure(&(to_part * surface)).map_err(|e| {
                     format!(
                         "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
@@ -246,6 +250,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let summary = stats
                 .summary()
                 .ok_or_else(|| format!("{}: the scan has no points", plan.describe(key)))?;
+            let best_fits = section::best_fits(&inputs.gauges[key.profile], &in_part)
+                .unwrap_or_else(|problem| {
+                    tracing::warn!(scan = %plan.describe(key), %problem, "report: no best fit of the section");
+                    Vec::new()
+                });
             all.merge(&stats);
             outside += profile_outside;
             profiles.push(ProfileReport {
@@ -255,6 +264,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                 scanned_at: scan.finished.clone(),
                 stats: summary,
                 verdict: inputs.tolerance.verdict(&summary, profile_outside),
+                best_fits,
                 points,
             });
         }

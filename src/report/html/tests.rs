@@ -80,6 +80,7 @@ fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceRepor
                 scanned_at: "2025-03-04T10:11:12Z".to_string(),
                 stats,
                 verdict,
+                best_fits: Vec::new(),
                 points,
             }
         })

@@ -53,6 +53,7 @@ fn profile(name: &str, x_mm: f64, machine: &str, deviations: [f64; 6]) -> Profil
         scanned_at: format!("2025-03-04T10:{:02}:00Z", x_mm as u32 / 10),
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
+        best_fits: Vec::new(),
         points,
     }
 }
