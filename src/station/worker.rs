@@ -635,7 +635,7 @@ impl Worker {
         let gap = streamed
             .as_ref()
             .ok()
-            .and_then(|centres| find_gap(&motion, centres));
+            .and_then(|centres| find_gap(&motion, centres, radius));
         let end = match (&streamed, &gap) {
             (Ok(_), None) => PipelineMsg::End { key: motion.key },
             _ => PipelineMsg::Cut { key: motion.key },

@@ -18,6 +18,9 @@ fn safety() -> Safety {
     }
 }
 
+/// The ball's radius, mm.
+const BALL: f64 = 1.0;
+
 const KEY: ProfileKey = ProfileKey {
     instance: 1,
     profile: 0,
@@ -74,7 +77,7 @@ fn centres(path: &KnownPath, offset: f64, per: usize) -> Vec<Point3<f64>> {
         .map(|(i, j, t)| {
             let p = path.surface[i] + (path.surface[j] - path.surface[i]) * t;
             let normal = (path.normals[i] * (1.0 - t) + path.normals[j] * t).normalize();
-            p + normal * (1.0 + offset)
+            p + normal * (BALL + offset)
         })
         .collect()
 }
@@ -86,7 +89,7 @@ fn a_whole_scan_has_no_gap_even_round_a_sharp_edge_and_off_the_nominal() {
         let motion = curve_motion(path.clone());
         let scan = centres(&path, offset, per);
         assert_eq!(
-            find_gap(&motion, &scan),
+            find_gap(&motion, &scan, BALL),
             None,
             "{count} nominals, {per} per spacing"
         );
@@ -101,8 +104,8 @@ fn a_lost_line_of_points_is_a_gap_wherever_it_was_lost() {
     for lost_from in [0, 37, 150, 199, 330, whole.len() - 10] {
         let mut scan = whole.clone();
         scan.drain(lost_from..lost_from + 10);
-        let gap =
-            find_gap(&motion, &scan).unwrap_or_else(|| panic!("10 points lost at {lost_from}"));
+        let gap = find_gap(&motion, &scan, BALL)
+            .unwrap_or_else(|| panic!("10 points lost at {lost_from}"));
         assert!(gap.length_mm > 3.0, "{gap}");
         match lost_from {
             0 => assert_eq!(gap.after, None),
@@ -110,7 +113,7 @@ fn a_lost_line_of_points_is_a_gap_wherever_it_was_lost() {
         }
     }
     // Nothing at all is a gap too.
-    assert!(find_gap(&motion, &[]).is_some());
+    assert!(find_gap(&motion, &[], BALL).is_some());
 }
 
 fn teach_motion() -> ScanMotion {
@@ -146,12 +149,12 @@ fn a_teach_scan_is_whole_when_its_steps_are_and_it_closes() {
     let turn = (std::f64::consts::TAU * 21.0).floor() as usize;
     let whole: Vec<Point3<f64>> = (0..turn).map(centre).collect();
     let motion = teach_motion();
-    assert_eq!(find_gap(&motion, &whole), None);
+    assert_eq!(find_gap(&motion, &whole, BALL), None);
     let mut holed = whole.clone();
     holed.drain(60..70);
-    assert_eq!(find_gap(&motion, &holed).unwrap().after, Some(59));
+    assert_eq!(find_gap(&motion, &holed, BALL).unwrap().after, Some(59));
     let cut = &whole[..turn - 10];
-    assert_eq!(find_gap(&motion, cut).unwrap().after, Some(turn - 11));
+    assert_eq!(find_gap(&motion, cut, BALL).unwrap().after, Some(turn - 11));
 }
 
 #[test]
@@ -166,16 +169,76 @@ fn the_last_few_points_lost_where_the_nominals_crowd_are_a_gap() {
         let motion = curve_motion(path.clone());
         let mut whole = centres(&path, offset, per);
         whole.rotate_left(path.entry * per);
-        assert_eq!(find_gap(&motion, &whole), None, "{count} nominals whole");
+        assert_eq!(
+            find_gap(&motion, &whole, BALL),
+            None,
+            "{count} nominals whole"
+        );
         for lost in 1 + per..=10 {
             let cut = &whole[..whole.len() - lost];
-            let gap = find_gap(&motion, cut)
+            let gap = find_gap(&motion, cut, BALL)
                 .unwrap_or_else(|| panic!("{count} nominals, the last {lost} points lost"));
             assert_eq!(gap.after, Some(cut.len() - 1), "{gap}");
         }
         // And the first line, where the scan enters (the nominals there grow apart too fast for a point or
         // two to tell from their spacing).
-        let gap = find_gap(&motion, &whole[10..]).expect("the first line lost");
+        let gap = find_gap(&motion, &whole[10..], BALL).expect("the first line lost");
         assert_eq!(gap.after, None, "{gap}");
+    }
+}
+
+/// `path` with its sharp trailing edge (its point farthest along +y) made a fan of `count` nominals at that one
+/// point, their normals turning from the upper face's to the lower face's, as the station's nominals are: the
+/// ball rolls round the edge while the surface path stays where it is.
+fn with_fan(path: &KnownPath, count: usize) -> KnownPath {
+    let n = path.surface.len();
+    let edge = (0..n)
+        .max_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
+        .unwrap();
+    let (before, after) = (
+        path.normals[(edge + n - 1) % n],
+        path.normals[(edge + 1) % n],
+    );
+    let mut fanned = path.clone();
+    let fan: Vec<Vector3<f64>> = (0..count)
+        .map(|k| {
+            let t = k as f64 / (count - 1) as f64;
+            (before * (1.0 - t) + after * t).normalize()
+        })
+        .collect();
+    fanned.normals.splice(edge..=edge, fan);
+    fanned
+        .surface
+        .splice(edge..=edge, std::iter::repeat_n(path.surface[edge], count));
+    fanned
+}
+
+#[test]
+fn the_first_lines_lost_round_a_sharp_trailing_edge_are_a_gap() {
+    // Entered on the upper face just ahead of the sharp trailing edge (the top of a pitched blade section is an
+    // edge): the scan's first points roll round the edge and come back along the lower face, close to where it
+    // entered, which is what is left when its first lines are lost (CI's campaign: C r200 with 370 of 390).
+    for (count, per, offset) in [(200, 1, 0.4), (272, 1, -0.4), (390, 1, 0.0), (200, 2, 0.4)] {
+        let mut path = with_fan(&naca_path(count), 16);
+        let edge = (0..path.surface.len())
+            .max_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
+            .unwrap();
+        for before in [1, 2, 3] {
+            path.entry = edge - before;
+            let motion = curve_motion(path.clone());
+            let mut whole = centres(&path, offset, per);
+            whole.rotate_left(path.entry * per);
+            assert_eq!(
+                find_gap(&motion, &whole, BALL),
+                None,
+                "{count} nominals whole"
+            );
+            for lost in [10, 20] {
+                let gap = find_gap(&motion, &whole[lost..], BALL).unwrap_or_else(|| {
+                    panic!("{count} nominals, entered {before} before the edge, the first {lost} points lost")
+                });
+                assert_eq!(gap.after, None, "{gap}");
+            }
+        }
     }
 }
