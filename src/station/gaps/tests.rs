@@ -162,18 +162,8 @@ fn the_last_few_points_lost_where_the_nominals_crowd_are_a_gap() {
     // The NACA's nominals crowd at its edges: entered at the leading edge, the scan ends there, where a data
     // line cut short (its last points lost) is shorter than one spacing of the faces.
     for (count, per, offset) in [(200, 1, 0.4), (272, 1, -0.4), (390, 1, 0.0), (200, 2, 0.4)] {
-        let mut path = naca_path(count);
-        path.entry = (0..count)
-            .min_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
-            .unwrap();
-        let motion = curve_motion(path.clone());
-        let mut whole = centres(&path, offset, per);
-        whole.rotate_left(path.entry * per);
-        assert_eq!(
-            find_gap(&motion, &whole, BALL),
-            None,
-            "{count} nominals whole"
-        );
+        let path = naca_path(count);
+        let (motion, whole) = whole_scan_entered_at(&path, edge(&path, Edge::Leading), offset, per);
         for lost in 1 + per..=10 {
             let cut = &whole[..whole.len() - lost];
             let gap = find_gap(&motion, cut, BALL)
@@ -187,14 +177,50 @@ fn the_last_few_points_lost_where_the_nominals_crowd_are_a_gap() {
     }
 }
 
+enum Edge {
+    Leading,
+    Trailing,
+}
+
+/// The nominal at the section's leading edge (least y) or trailing edge (greatest y; the first of a fan).
+fn edge(path: &KnownPath, which: Edge) -> usize {
+    let y = |i: usize| path.surface[i].y;
+    let all = 0..path.surface.len();
+    match which {
+        Edge::Leading => all.min_by(|&a, &b| y(a).total_cmp(&y(b))),
+        Edge::Trailing => all.max_by(|&a, &b| y(a).total_cmp(&y(b)).then(b.cmp(&a))),
+    }
+    .unwrap()
+}
+
+/// The motion of a scan of `path` entered at nominal `entry`, and its whole scan (see [`centres`]), which has
+/// no gap.
+fn whole_scan_entered_at(
+    path: &KnownPath,
+    entry: usize,
+    offset: f64,
+    per: usize,
+) -> (ScanMotion, Vec<Point3<f64>>) {
+    let mut path = path.clone();
+    path.entry = entry;
+    let motion = curve_motion(path.clone());
+    let mut whole = centres(&path, offset, per);
+    whole.rotate_left(entry * per);
+    assert_eq!(
+        find_gap(&motion, &whole, BALL),
+        None,
+        "{} nominals entered at {entry}: whole",
+        path.surface.len()
+    );
+    (motion, whole)
+}
+
 /// `path` with its sharp trailing edge (its point farthest along +y) made a fan of `count` nominals at that one
 /// point, their normals turning from the upper face's to the lower face's, as the station's nominals are: the
 /// ball rolls round the edge while the surface path stays where it is.
 fn with_fan(path: &KnownPath, count: usize) -> KnownPath {
     let n = path.surface.len();
-    let edge = (0..n)
-        .max_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
-        .unwrap();
+    let edge = edge(path, Edge::Trailing);
     let (before, after) = (
         path.normals[(edge + n - 1) % n],
         path.normals[(edge + 1) % n],
@@ -219,23 +245,14 @@ fn the_first_lines_lost_round_a_sharp_trailing_edge_are_a_gap() {
     // edge): the scan's first points roll round the edge and come back along the lower face, close to where it
     // entered, which is what is left when its first lines are lost (CI's campaign: C r200 with 370 of 390).
     for (count, per, offset) in [(200, 1, 0.4), (272, 1, -0.4), (390, 1, 0.0), (200, 2, 0.4)] {
-        let mut path = with_fan(&naca_path(count), 16);
-        let edge = (0..path.surface.len())
-            .max_by(|&a, &b| path.surface[a].y.total_cmp(&path.surface[b].y))
-            .unwrap();
-        for before in [1, 2, 3] {
-            path.entry = edge - before;
-            let motion = curve_motion(path.clone());
-            let mut whole = centres(&path, offset, per);
-            whole.rotate_left(path.entry * per);
-            assert_eq!(
-                find_gap(&motion, &whole, BALL),
-                None,
-                "{count} nominals whole"
-            );
+        let path = with_fan(&naca_path(count), 16);
+        let trailing = edge(&path, Edge::Trailing);
+        // Entered one nominal ahead of the edge, as the campaign's C r200 was, or on the edge's fan itself.
+        for entry in [trailing - 1, trailing + 12, trailing + 14] {
+            let (motion, whole) = whole_scan_entered_at(&path, entry, offset, per);
             for lost in [10, 20] {
                 let gap = find_gap(&motion, &whole[lost..], BALL).unwrap_or_else(|| {
-                    panic!("{count} nominals, entered {before} before the edge, the first {lost} points lost")
+                    panic!("{count} nominals, entered at {entry} (edge {trailing}), the first {lost} points lost")
                 });
                 assert_eq!(gap.after, None, "{gap}");
             }
