@@ -1,8 +1,9 @@
 //! Whether a scan that ended well is whole: a line of points lost on the way (the machine's data lines carry
 //! several points each) leaves a hole the machine never reports. A scan along a nominal curve is followed along
-//! that curve: each ball centre is placed at its arc length on the nominal path (the surface and the ball centres), and a step along it longer than
-//! the scan's spacing allows, or a start or an end short of the curve's, is a gap. A teach scan has no nominal:
-//! its ball centres must lie no further apart than its step allows, and close where they began.
+//! that curve: each ball centre is placed at its arc length on the nominal path (the surface's, and the ball
+//! centres'), and a step along it longer than the scan's spacing allows, or a start or an end short of the
+//! curve's, is a gap. A teach scan has no nominal: its ball centres must lie no further apart than its step
+//! allows, and close where they began.
 
 use std::fmt;
 
