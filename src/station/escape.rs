@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point3, Rotation3, Unit, Vector3};
 use zeroset_drivers::machine::CurveScan;
 
 use crate::config::Safety;
@@ -162,6 +162,75 @@ impl KnownPath {
     }
 }
 
+/// The offset points strictly between path points `a` and `b` whose normals turn by more than the waypoint turn:
+/// the surface point interpolated along the segment and the normal turned from one to the other about their
+/// common perpendicular, at `offset` mm, no two more than the waypoint turn apart. None for normals too near
+/// opposite to say which way round (the way out's check then judges the straight leg).
+fn round_the_turn(path: &KnownPath, a: usize, b: usize, offset: f64) -> Vec<Point3<f64>> {
+    let (from, to) = (path.normals[a], path.normals[b]);
+    let Some(axis) = Unit::try_new(from.cross(&to), 1e-6) else {
+        return Vec::new();
+    };
+    let turn = from.angle(&to);
+    let steps = (turn / WAYPOINT_TURN_RAD).ceil() as usize;
+    (1..steps)
+        .map(|k| {
+            let t = k as f64 / steps as f64;
+            let normal = Rotation3::from_axis_angle(&axis, turn * t) * from;
+            path.surface[a] + (path.surface[b] - path.surface[a]) * t + normal * offset
+        })
+        .collect()
+}
+
+/// The way back round the open end of a path for a ball that went round it unreported (a teach scan stopped just
+/// past a sharp edge, its last report before the edge): straight away from the last known point by `margin` mm (to
+/// at least the ball and the margin from it), then round that point at that distance, back the way the ball went
+/// (about the axis that turns the path's normals into its direction of travel), to over the last point. None when the
+/// foot is neither on the path's last segment nor the ball within the path tolerance of the end, or the end gives
+/// no direction of travel: then the ball is inside the known surface, not round its end.
+fn round_the_open_end(
+    path: &KnownPath,
+    foot: &Foot,
+    position: &Point3<f64>,
+    ball_radius: f64,
+    margin: f64,
+) -> Option<Vec<Point3<f64>>> {
+    let offset = ball_radius + margin;
+    let n = path.surface.len();
+    if path.closed || n < 2 {
+        return None;
+    }
+    let (pivot, normal) = (path.surface[n - 1], path.normals[n - 1]);
+    // On the last segment, or within the reach of the end the way out allows a path (round a thin edge and back
+    // under the face, the nearest segment is one before).
+    if foot.segment != n - 2 && (position - pivot).norm() > offset + ON_PATH_TOLERANCE_MM {
+        return None;
+    }
+    // The way the path turns its normals into its direction of travel, over the whole path: a plane scan's normal,
+    // signed by the side the part is on. The last segment alone can point anywhere when its end was placed from
+    // positions reported either side of a sharp turn.
+    let turning: Vector3<f64> = (0..n - 1)
+        .map(|i| path.normals[i].cross(&(path.surface[i + 1] - path.surface[i])))
+        .sum();
+    let axis = Unit::try_new(turning, 1e-9)?;
+    let away = (position - pivot).try_normalize(1e-9)?;
+    let mut turned = normal.cross(&away).dot(&axis).atan2(normal.dot(&away));
+    if turned < 0.0 {
+        turned += std::f64::consts::TAU;
+    }
+    // Radially off a point of the part never nearer the part where it is convex; under a face behind the end the
+    // radial lift runs nearly along the face, so it goes the whole margin beyond where the ball is.
+    let radius = offset.max((position - pivot).norm() + margin);
+    let steps = (turned / WAYPOINT_TURN_RAD).ceil() as usize;
+    let mut arc = vec![pivot + away * radius];
+    arc.extend((1..steps).map(|k| {
+        let back = turned * (1.0 - k as f64 / steps as f64);
+        pivot + Rotation3::from_axis_angle(&axis, back) * normal * radius
+    }));
+    arc.push(pivot + normal * radius);
+    Some(arc)
+}
+
 /// The moves that take the ball from `position` to the clearance height: off the known surface along its normal
 /// to `margin` mm beyond the ball, along the path at that offset back to the entry, then straight up. Empty when
 /// the ball is already at or above the clearance height.
@@ -171,7 +240,8 @@ impl KnownPath {
 /// concave with a radius larger than the ball and the margin. A ball that stopped past the end of an open path (a
 /// teach scan's last points not yet reported) lifts across its own unreported travel: perpendicular to the chord
 /// from the last reported centre, on the outside; such a stretch no longer than the margin's allowance is taken
-/// as locally convex, a longer one is refused.
+/// as locally convex, a longer one is refused. A ball that went round the open end unreported and lies on the
+/// inner side of the last known surface (round a knife edge) goes back round that end's last point (`round_the_open_end`).
 pub fn way_out(
     position: Point3<f64>,
     path: Option<&KnownPath>,
@@ -211,7 +281,20 @@ pub fn way_out(
         });
     }
     let normal = foot.normal;
-    let (lifted, join) = if foot.past_end {
+    let inside = (position - foot.point).dot(&normal) < 0.0;
+    let (lift, join) = if inside {
+        match round_the_open_end(path, &foot, &position, ball_radius, margin) {
+            Some(arc) => (arc, path.surface.len() - 1),
+            // The ball centre lies on the inner side of the known surface, away from an open end it could have
+            // gone round: that surface is not where the part is, and no move away from it can be trusted.
+            None => {
+                return Err(EscapeError::OffPath {
+                    position,
+                    off_path_mm: -foot.distance,
+                })
+            }
+        }
+    } else if foot.past_end {
         let last = path.surface.len() - 1;
         let centre = path.surface[last] + path.normals[last] * ball_radius;
         let chord = position - centre;
@@ -219,34 +302,39 @@ pub fn way_out(
         let out = (normal - chord * (normal.dot(&chord) / chord.norm_squared().max(1e-300)))
             .try_normalize(1e-9)
             .unwrap_or(normal);
-        (position + out * margin, last)
+        (vec![position + out * margin], last)
     } else {
         let away = (position - foot.point)
             .try_normalize(1e-9)
             .filter(|u| u.dot(&normal) > 0.0)
             .unwrap_or(normal);
-        if (position - foot.point).dot(&normal) < 0.0 {
-            // The ball centre lies on the inner side of the known surface: that surface is not where the part
-            // is, and no move away from it can be trusted.
-            return Err(EscapeError::OffPath {
-                position,
-                off_path_mm: -foot.distance,
-            });
-        }
         let lift = (ball_radius + margin - foot.distance).max(0.0);
-        (position + away * lift, foot.toward_entry)
+        (vec![position + away * lift], foot.toward_entry)
     };
     let offset = |i: usize| path.surface[i] + path.normals[i] * (ball_radius + margin);
-    let mut moves = vec![lifted];
+    let mut moves = lift;
     let mut last = join;
+    let mut previous = join;
     moves.push(offset(join));
     for i in walk(join, path.entry, path.surface.len(), path.closed) {
-        let far = (path.surface[i] - path.surface[last]).norm() >= WAYPOINT_SPACING_MM;
-        let turned = path.normals[i].angle(&path.normals[last]) >= WAYPOINT_TURN_RAD;
-        if far || turned || i == path.entry {
+        if path.normals[i].angle(&path.normals[previous]) > WAYPOINT_TURN_RAD {
+            // A sharp turn between two neighbours (a knife edge's fan, or reports 2 mm apart either side of it):
+            // round it at the offset, as the ball went round, not along the chord that cuts the edge.
+            if last != previous {
+                moves.push(offset(previous));
+            }
+            moves.extend(round_the_turn(path, previous, i, ball_radius + margin));
             moves.push(offset(i));
             last = i;
+        } else {
+            let far = (path.surface[i] - path.surface[last]).norm() >= WAYPOINT_SPACING_MM;
+            let turned = path.normals[i].angle(&path.normals[last]) >= WAYPOINT_TURN_RAD;
+            if far || turned || i == path.entry {
+                moves.push(offset(i));
+                last = i;
+            }
         }
+        previous = i;
     }
     let exit = offset(path.entry);
     moves.push(Point3::new(exit.x, exit.y, clearance_z.max(exit.z)));
@@ -415,6 +503,8 @@ struct Foot {
     toward_entry: usize,
     /// The foot is the end of an open path and the centre lies beyond it.
     past_end: bool,
+    /// The index of the first point of the segment the foot lies on (0 for a one-point path).
+    segment: usize,
 }
 
 fn nearest_on_path(path: &KnownPath, centre: &Point3<f64>) -> Foot {
@@ -426,6 +516,7 @@ fn nearest_on_path(path: &KnownPath, centre: &Point3<f64>) -> Foot {
         distance: (centre - path.surface[0]).norm(),
         toward_entry: 0,
         past_end: false,
+        segment: 0,
     };
     for i in 0..segments {
         let j = (i + 1) % n;
@@ -446,6 +537,7 @@ fn nearest_on_path(path: &KnownPath, centre: &Point3<f64>) -> Foot {
                 distance,
                 toward_entry,
                 past_end: false,
+                segment: i,
             };
         }
     }
@@ -483,6 +575,9 @@ fn walk(from: usize, to: usize, len: usize, closed: bool) -> Vec<usize> {
         (from + 1..=to).collect()
     }
 }
+
+mod trail;
+pub use trail::extend_by_trail;
 
 #[cfg(test)]
 pub(crate) mod tests;
