@@ -7,18 +7,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use futures::StreamExt;
+use futures::{FutureExt, StreamExt};
 use nalgebra::{Point3, Vector3};
 use tokio::sync::{broadcast, mpsc, oneshot};
 use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::machine::{
-    Error as MachineError, ErrorKind, Event, Machine, ScanStream, Speeds, Xyz,
+    Error as MachineError, ErrorKind, Event, InPlaneScan, Machine, MoveReportRate, MoveReports,
+    ScanStream, Speeds, Xyz,
 };
 use zeroset_drivers::transport::SerialConfig;
 use zeroset_drivers::transport::{open_pty, open_serial};
+use zeroset_drivers::wire::EventTag;
 
 use super::core::Input;
-use super::escape::{check_way_out, plan_escape, EscapeModel, ScanPath};
+use super::escape::{check_way_out, extend_by_trail, plan_escape, EscapeModel, ScanPath};
 use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
 use super::pipeline::PipelineMsg;
@@ -34,6 +36,8 @@ use watch::locks_motion;
 const PROTOCOL_ERROR: u16 = 8;
 /// A position this far below the clearance height still counts as at it (the rounding of a reported position), mm.
 const AT_HEIGHT_TOLERANCE_MM: f64 = 1e-3;
+/// How often a teach scan's trail reports the ball centre: the I++ floor, 2 mm of travel at 20 mm/s.
+const TRAIL_INTERVAL: Duration = Duration::from_millis(100);
 
 /// What a worker is asked to do.
 pub enum Order {
@@ -127,6 +131,9 @@ pub fn spawn_on(
         session: false,
         ball_radius: None,
         path: None,
+        trail: None,
+        trail_refused: false,
+        travel: None,
         fault: None,
         seen: false,
     };
@@ -175,6 +182,15 @@ struct Worker {
     ball_radius: Option<f64>,
     /// The surface around the probe as far as the station knows it: the last scan's.
     path: Option<ScanPath>,
+    /// The move-report daemon of a teach scan that stopped, still running on the machine (it outlives an
+    /// emergency stop and ClearAllErrors, and the machine takes one at a time): stopped by the next clear.
+    trail: Option<EventTag>,
+    /// The machine refused move reports on this link (a daemon a killed predecessor started, say): teach scans
+    /// run without a trail until the link is opened again, rather than be refused the same way each time.
+    trail_refused: bool,
+    /// The ball centres the machine reported in a teach scan that stopped, with that scan's plan: with the position
+    /// the probe is found at, they extend the known path past its last point for the way out (`escape::trail`).
+    travel: Option<(InPlaneScan, Vec<Point3<f64>>)>,
     /// Why the machine may not move until the operator's clear: a failed order, or what the watch saw while idle.
     fault: Option<WorkerError>,
     /// Whether the watch has told the daemon the machine is ready (once, at its first healthy look).
@@ -489,6 +505,9 @@ impl Worker {
         *self.link.lock().expect("not poisoned") = None;
         self.alarms = None;
         self.session = false;
+        // A daemon lives in its session: stopping one a new session does not hold would be an error (0513).
+        self.trail = None;
+        self.trail_refused = false;
     }
 
     /// Clears the machine's errors (on a new link, starting a session does; a session the machine no longer
@@ -503,6 +522,7 @@ impl Worker {
             }
             result => result?,
         };
+        self.stop_trail(&client).await?;
         // The way out first, with the tool the machine has on: changing it moves the head, so the station sets
         // the machine up (`prepare`) only once the probe is at the clearance height.
         self.ball_radius = None;
@@ -511,6 +531,7 @@ impl Worker {
             self.leave_the_part(&client, here, model).await?;
         }
         self.path = None;
+        self.travel = None;
         self.prepare().await?;
         Ok(())
     }
@@ -541,7 +562,15 @@ impl Worker {
             a.distance_mm(&here, radius)
                 .total_cmp(&b.distance_mm(&here, radius))
         });
-        let candidates: Vec<&ScanPath> = self.path.iter().chain(candidates).collect();
+        let own = self.path.clone().map(|mut scan| {
+            if let Some((plan, travel)) = &self.travel {
+                let trail: Vec<Point3<f64>> = travel.iter().copied().chain([here]).collect();
+                let added = extend_by_trail(&mut scan.path, &trail, plan, radius);
+                tracing::info!(machine = %self.name, scan = %scan.name, reports = travel.len(), added, "the known path extended past the last scan point by the positions the machine reported and the one it is at");
+            }
+            scan
+        });
+        let candidates: Vec<&ScanPath> = own.iter().chain(candidates).collect();
         let mut refusal = None;
         let mut moves = None;
         for scan in &candidates {
@@ -599,6 +628,7 @@ impl Worker {
             path: motion.path.clone(),
             margin_mm: motion.margin_mm,
         });
+        self.travel = None;
         for target in &motion.approach {
             self.not_aborted()?;
             client.go_to(xyz(target)).await?;
@@ -621,13 +651,17 @@ impl Worker {
         if pipeline.send(start).await.is_err() {
             return Err(self.pipeline_gone());
         }
+        let trail = match &motion.scan {
+            Scan::InPlane(plan) => self.start_trail(&client, plan, &motion.name).await,
+            Scan::Curve(_) => None,
+        };
         self.not_aborted()?;
         let started = match &motion.scan {
             Scan::InPlane(plan) => scanning.scan_in_plane(plan.clone()).await,
             Scan::Curve(plan) => scanning.scan_on_curve(plan.clone()).await,
         };
         let streamed = match started {
-            Ok(stream) => self.stream(stream, &motion, &pipeline, radius).await,
+            Ok(stream) => self.stream(stream, trail, &motion, &pipeline, radius).await,
             Err(error) => Err(error.into()),
         };
         // A scan that ended well may still have lost a line of points on the way: then it is kept as a cut scan,
@@ -644,6 +678,7 @@ impl Worker {
             return Err(self.pipeline_gone());
         }
         streamed?;
+        self.stop_trail(&client).await?;
         self.retract(&client, &motion, radius, part).await?;
         match gap {
             None => Ok(()),
@@ -704,19 +739,44 @@ impl Worker {
     }
 
     /// Forwards the scan's points to the pipeline as they arrive, extending the known path with them when the
-    /// profile's shape was unknown. Returns the ball centres, for the check that the scan is whole.
+    /// profile's shape was unknown, and, should the scan stop, with the trail of positions the machine reported
+    /// past them. Returns the ball centres, for the check that the scan is whole.
     async fn stream(
         &mut self,
         mut stream: ScanStream,
+        mut reports: Option<MoveReports>,
         motion: &ScanMotion,
         pipeline: &mpsc::Sender<PipelineMsg>,
         radius: f64,
     ) -> Result<Vec<Point3<f64>>, WorkerError> {
         let teaching = matches!(motion.scan, Scan::InPlane(_));
         let mut centres = Vec::new();
-        while let Some(item) = stream.next().await {
+        let mut trail = Vec::new();
+        loop {
+            let item = tokio::select! {
+                biased;
+                report = next_report(&mut reports) => {
+                    match report {
+                        Some(Ok(p)) => trail.push(Point3::new(p.x, p.y, p.z)),
+                        _ => reports = None,
+                    }
+                    continue;
+                }
+                item = stream.next() => item,
+            };
+            let Some(item) = item else {
+                break;
+            };
             let received_us = super::clock::unix_us();
-            let point = item?;
+            let point = match item {
+                Ok(point) => point,
+                Err(error) => {
+                    if let Scan::InPlane(plan) = &motion.scan {
+                        self.follow_trail(reports.as_mut(), trail, plan);
+                    }
+                    return Err(error.into());
+                }
+            };
             let raw = RawPoint {
                 centre: [point.centre.x, point.centre.y, point.centre.z],
                 normal: [point.normal.x, point.normal.y, point.normal.z],
@@ -749,6 +809,72 @@ impl Worker {
         Ok(centres)
     }
 
+    /// Starts the ball-centre reports of a teach scan, the one record of its travel past the last point the
+    /// machine sent should it stop (`escape::trail`). Without them the scan still runs: a stop then leaves a way
+    /// out only within a few millimetres of the last point, and the clear says so.
+    async fn start_trail(
+        &mut self,
+        client: &Link,
+        plan: &InPlaneScan,
+        scan: &str,
+    ) -> Option<MoveReports> {
+        if self.trail_refused {
+            return None;
+        }
+        let Some(reporting) = client.move_reporting() else {
+            tracing::warn!(machine = %self.name, scan, "the machine sends no move reports: a stop in this teach scan may leave the probe where no way out is known");
+            return None;
+        };
+        let rate = MoveReportRate {
+            interval: TRAIL_INTERVAL,
+            distance: plan.step,
+        };
+        match reporting.start_move_reports(rate).await {
+            Ok(reports) => {
+                self.trail = Some(reports.daemon());
+                Some(reports)
+            }
+            Err(error) => {
+                self.trail_refused = true;
+                tracing::warn!(machine = %self.name, scan, %error, "move reports refused: a stop in this teach scan may leave the probe where no way out is known");
+                None
+            }
+        }
+    }
+
+    /// After a teach scan stopped: keeps the positions reported by now, for the way out the next clear plans.
+    fn follow_trail(
+        &mut self,
+        reports: Option<&mut MoveReports>,
+        mut trail: Vec<Point3<f64>>,
+        plan: &InPlaneScan,
+    ) {
+        if let Some(reports) = reports {
+            while let Some(Some(Ok(p))) = reports.next().now_or_never() {
+                trail.push(Point3::new(p.x, p.y, p.z));
+            }
+        }
+        self.travel = Some((plan.clone(), trail));
+    }
+
+    /// Stops the move reports a teach scan started (after a stop, once the errors are cleared: the machine
+    /// refuses StopDaemon in error).
+    async fn stop_trail(&mut self, client: &Link) -> Result<(), WorkerError> {
+        let (Some(daemon), Some(reporting)) = (self.trail.take(), client.move_reporting()) else {
+            return Ok(());
+        };
+        reporting.stop_move_reports(daemon).await.map_err(|error| {
+            let error = WorkerError::from(error);
+            WorkerError {
+                message: format!(
+                    "machine {}: its move reports could not be stopped ({}); nothing was moved; run `zeroset clear`",
+                    self.name, error.message
+                ),
+                ..error
+            }
+        })
+    }
+
     /// Refuses the next motion command after an operator's abort, until a clear.
     fn not_aborted(&self) -> Result<(), WorkerError> {
         if self.aborted.load(Ordering::SeqCst) {
@@ -771,6 +897,14 @@ impl Worker {
                 self.name
             ),
         }
+    }
+}
+
+/// The next move report, or never when there are none (a select's branch that stays silent).
+async fn next_report(reports: &mut Option<MoveReports>) -> Option<Result<Xyz, MachineError>> {
+    match reports {
+        Some(reports) => reports.next().await,
+        None => std::future::pending().await,
     }
 }
 

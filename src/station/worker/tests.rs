@@ -8,7 +8,8 @@ use futures::stream;
 use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc};
 use zeroset_drivers::machine::{
-    CurveScan, Density, MockMachine, MockScanning, Nominal, ScanPoint, ScanStream, Scanning, Xyz,
+    CurveScan, Density, InPlaneScan, MockMachine, MockMoveReporting, MockScanning, MoveReporting,
+    MoveReports, Nominal, ScanPoint, ScanStream, Scanning, Xyz,
 };
 
 use super::*;
@@ -77,7 +78,21 @@ fn bare_machine(
     moves: Option<Arc<Mutex<Vec<Xyz>>>>,
     scan: Vec<ScanPoint>,
 ) -> MockMachine {
+    scanning_machine(positions, moves, scan, None, None)
+}
+
+/// Like [`bare_machine`], its scans ending with `stopped_by` after their points, its move reports `reporting`.
+fn scanning_machine(
+    positions: Vec<Xyz>,
+    moves: Option<Arc<Mutex<Vec<Xyz>>>>,
+    scan: Vec<ScanPoint>,
+    stopped_by: Option<MachineError>,
+    reporting: Option<Arc<dyn MoveReporting>>,
+) -> MockMachine {
     let mut machine = MockMachine::new();
+    machine
+        .expect_move_reporting()
+        .returning(move || reporting.clone());
     machine
         .expect_events()
         .returning(|| broadcast::channel(1).1);
@@ -116,8 +131,9 @@ fn bare_machine(
         .expect_scan_in_plane()
         .times(0..=1)
         .returning(move |_| {
+            let ending = stopped_by.clone().map(Err);
             Ok(ScanStream::new(stream::iter(
-                in_plane.clone().into_iter().map(Ok),
+                in_plane.clone().into_iter().map(Ok).chain(ending),
             )))
         });
     let scanning: Arc<dyn Scanning> = Arc::new(scanning);
@@ -525,11 +541,16 @@ fn lost(command: &str) -> MachineError {
 
 /// I++ 0008 for `command`: what a controller answers on a session it does not (or already) hold.
 fn protocol_error(command: &str) -> MachineError {
+    device_error(command, 3, PROTOCOL_ERROR, "Protocol error")
+}
+
+/// The device error `code` (`text`, of `severity`) on `command`.
+fn device_error(command: &str, severity: u8, code: u16, text: &str) -> MachineError {
     let error = zeroset_drivers::wire::DeviceError::new(
-        3,
-        PROTOCOL_ERROR,
+        severity,
+        code,
         zeroset_drivers::wire::WireString::new(command).unwrap(),
-        zeroset_drivers::wire::WireString::new("Protocol error").unwrap(),
+        zeroset_drivers::wire::WireString::new(text).unwrap(),
     )
     .unwrap();
     MachineError::new(
@@ -678,6 +699,113 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
         "{planned:?}"
     );
     assert_eq!(planned.len(), 4);
+}
+
+/// The teach scan of the circle from its top towards +y, for a 1 mm ball, and its known path at the start.
+fn teach_motion() -> ScanMotion {
+    let xyz = |x, y, z| Xyz::new(x, y, z);
+    let scan = Scan::InPlane(InPlaneScan {
+        start: xyz(100.0, 0.0, 20.0),
+        start_normal: xyz(0.0, 0.0, 1.0),
+        plane_normal: xyz(1.0, 0.0, 0.0),
+        direction: xyz(100.0, -1.0, 20.0),
+        step: 2.0,
+        end: xyz(100.0, 0.0, 20.0),
+        stop_diameter: 3.0,
+        passes: 1,
+        end_normal: xyz(0.0, 0.0, 1.0),
+    });
+    let start = KnownPath {
+        surface: vec![Point3::new(100.0, 0.0, 20.0)],
+        normals: vec![nalgebra::Vector3::new(0.0, 0.0, 1.0)],
+        closed: false,
+        entry: 0,
+    };
+    ScanMotion::plan(KEY, "A r100".into(), scan, start, 5.0, &safety()).unwrap()
+}
+
+/// A teach scan of the circle stopped by an emergency stop at its 30th point (150 degrees round, under it) with
+/// only its first 20 points sent; the machine's move reports (`reported`) every second point up to the stop.
+/// Returns what the clear answered and the moves it made.
+async fn clear_after_a_stop_in_a_teach_scan(reported: bool) -> (ScanResult, Vec<Xyz>) {
+    let round = whole_circle();
+    let stopped = round[30];
+    let positions = vec![Xyz::new(0.0, 0.0, 400.0), stopped.centre];
+    // What the scan's own transaction ends with on an emergency stop: 0006, transaction aborted.
+    let estop = device_error("ScanInPlaneEndIsSphere", 2, 6, "Transaction aborted");
+    let reporting: Option<Arc<dyn MoveReporting>> = reported.then(|| {
+        let mut reporting = MockMoveReporting::new();
+        let trail: Vec<Xyz> = round[..=30].iter().step_by(2).map(|p| p.centre).collect();
+        reporting
+            .expect_start_move_reports()
+            .times(1)
+            .returning(move |rate| {
+                assert_eq!(rate.interval, Duration::from_millis(100));
+                let tag = zeroset_drivers::wire::EventTag::new(1).unwrap();
+                Ok(MoveReports::new(
+                    tag,
+                    stream::iter(trail.clone().into_iter().map(Ok)),
+                ))
+            });
+        reporting
+            .expect_stop_move_reports()
+            .times(1)
+            .returning(|_| Ok(()));
+        Arc::new(reporting) as Arc<dyn MoveReporting>
+    });
+    let moves = Arc::new(Mutex::new(Vec::new()));
+    let mut machine = scanning_machine(
+        positions,
+        Some(moves.clone()),
+        round[..20].to_vec(),
+        Some(estop),
+        reporting,
+    );
+    machine.expect_start_session().returning(|| Ok(()));
+    machine.expect_clear_all_errors().returning(|| Ok(()));
+    let (worker, mut reports) = worker_on(machine);
+    let (pipeline, _analysis) = mpsc::channel(128);
+    let motion = teach_motion();
+    let approach = motion.approach.len();
+    send_scan(&worker, motion, pipeline).await;
+    scan_result(&mut reports).await.unwrap_err();
+    let cleared = clear(&worker, EscapeModel::default()).await;
+    let moves = moves.lock().unwrap()[approach..].to_vec();
+    (cleared, moves)
+}
+
+#[tokio::test]
+async fn a_teach_scan_stopped_past_its_last_sent_point_leaves_by_the_positions_the_machine_reported(
+) {
+    // Without the reports the probe is 10 points (17 mm of travel) past the last point known: no way out is known.
+    let (blind, moves) = clear_after_a_stop_in_a_teach_scan(false).await;
+    let refusal = blind.unwrap_err();
+    assert_eq!(refusal.kind, FaultKind::Refused, "{}", refusal.message);
+    assert!(
+        refusal.message.contains("from the path it was scanning"),
+        "{}",
+        refusal.message
+    );
+    assert!(moves.is_empty(), "{moves:?}");
+    // With them, the clear lifts off the circle's side and follows the reported travel back over the top.
+    let (cleared, moves) = clear_after_a_stop_in_a_teach_scan(true).await;
+    cleared.expect("cleared");
+    let (first, last) = (moves[0], moves[moves.len() - 1]);
+    let stop = whole_circle()[30].centre;
+    let out = (Point3::new(first.x, first.y, first.z) - Point3::new(100.0, 0.0, 0.0)).norm()
+        - (Point3::new(stop.x, stop.y, stop.z) - Point3::new(100.0, 0.0, 0.0)).norm();
+    assert!(out > 4.0, "lifts off outwards by the margin: {first:?}");
+    assert!(
+        close(&last, &Xyz::new(100.0, 0.0, CLEARANCE_MM)),
+        "{last:?}"
+    );
+    for target in &moves {
+        let radial = (target.y.powi(2) + target.z.powi(2)).sqrt();
+        assert!(
+            radial > 20.0 + 1.0 + 4.5 || target.z > 26.0,
+            "a waypoint inside the margin round the circle: {target:?}"
+        );
+    }
 }
 
 #[tokio::test]
