@@ -661,25 +661,7 @@ async fn a_scan_with_a_hole_is_cut_not_counted_and_the_probe_still_leaves_as_pla
 
 #[tokio::test]
 async fn a_teach_scan_sends_exactly_its_planned_motion() {
-    let xyz = |x, y, z| Xyz::new(x, y, z);
-    let scan = Scan::InPlane(zeroset_drivers::machine::InPlaneScan {
-        start: xyz(100.0, 0.0, 20.0),
-        start_normal: xyz(0.0, 0.0, 1.0),
-        plane_normal: xyz(1.0, 0.0, 0.0),
-        direction: xyz(100.0, 1.0, 20.0),
-        step: 2.0,
-        end: xyz(100.0, 0.0, 20.0),
-        stop_diameter: 3.0,
-        passes: 1,
-        end_normal: xyz(0.0, 0.0, 1.0),
-    });
-    let start = KnownPath {
-        surface: vec![Point3::new(100.0, 0.0, 20.0)],
-        normals: vec![nalgebra::Vector3::new(0.0, 0.0, 1.0)],
-        closed: false,
-        entry: 0,
-    };
-    let motion = ScanMotion::plan(KEY, "A r100".into(), scan, start, 5.0, &safety()).unwrap();
+    let motion = teach_motion(1.0);
     let moves = Arc::new(Mutex::new(Vec::new()));
     let positions = vec![Xyz::new(0.0, 0.0, 400.0), Xyz::new(100.0, 0.0, 21.0)];
     let (worker, mut reports) = worker_on(machine(positions, moves.clone(), whole_circle()));
@@ -701,14 +683,14 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
     assert_eq!(planned.len(), 4);
 }
 
-/// The teach scan of the circle from its top towards +y, for a 1 mm ball, and its known path at the start.
-fn teach_motion() -> ScanMotion {
+/// The teach scan of the circle from its top, towards y = `towards_y` (+1 or -1), for a 1 mm ball.
+fn teach_motion(towards_y: f64) -> ScanMotion {
     let xyz = |x, y, z| Xyz::new(x, y, z);
     let scan = Scan::InPlane(InPlaneScan {
         start: xyz(100.0, 0.0, 20.0),
         start_normal: xyz(0.0, 0.0, 1.0),
         plane_normal: xyz(1.0, 0.0, 0.0),
-        direction: xyz(100.0, -1.0, 20.0),
+        direction: xyz(100.0, towards_y, 20.0),
         step: 2.0,
         end: xyz(100.0, 0.0, 20.0),
         stop_diameter: 3.0,
@@ -765,7 +747,7 @@ async fn clear_after_a_stop_in_a_teach_scan(reported: bool) -> (ScanResult, Vec<
     machine.expect_clear_all_errors().returning(|| Ok(()));
     let (worker, mut reports) = worker_on(machine);
     let (pipeline, _analysis) = mpsc::channel(128);
-    let motion = teach_motion();
+    let motion = teach_motion(-1.0);
     let approach = motion.approach.len();
     send_scan(&worker, motion, pipeline).await;
     scan_result(&mut reports).await.unwrap_err();
