@@ -258,12 +258,7 @@ async fn a_scan_sends_exactly_its_planned_motion_which_is_what_the_clearance_che
     scan_result(&mut reports).await.expect("scanned");
 
     let sent = moves.lock().unwrap().clone();
-    let planned: Vec<Xyz> = motion
-        .approach
-        .iter()
-        .chain(&motion.retract)
-        .map(xyz_of)
-        .collect();
+    let planned = planned_moves(&motion);
     assert_eq!(
         sent, planned,
         "the wire's GoTo targets are the plan's, bit for bit"
@@ -641,12 +636,7 @@ async fn a_scan_with_a_hole_is_cut_not_counted_and_the_probe_still_leaves_as_pla
         "{}",
         error.message
     );
-    let planned: Vec<Xyz> = motion
-        .approach
-        .iter()
-        .chain(&motion.retract)
-        .map(xyz_of)
-        .collect();
+    let planned = planned_moves(&motion);
     assert_eq!(
         *moves.lock().unwrap(),
         planned,
@@ -668,12 +658,7 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
     let (pipeline, _analysis) = mpsc::channel(128);
     send_scan(&worker, motion.clone(), pipeline).await;
     scan_result(&mut reports).await.expect("taught");
-    let planned: Vec<Xyz> = motion
-        .approach
-        .iter()
-        .chain(&motion.retract)
-        .map(xyz_of)
-        .collect();
+    let planned = planned_moves(&motion);
     assert_eq!(*moves.lock().unwrap(), planned);
     // Straight down over the start by the planned ball and the teach margin, and back up the same way.
     assert!(
@@ -681,6 +666,16 @@ async fn a_teach_scan_sends_exactly_its_planned_motion() {
         "{planned:?}"
     );
     assert_eq!(planned.len(), 4);
+}
+
+/// The GoTo targets a scan's motion plans: its approach, then its retract.
+fn planned_moves(motion: &ScanMotion) -> Vec<Xyz> {
+    motion
+        .approach
+        .iter()
+        .chain(&motion.retract)
+        .map(xyz_of)
+        .collect()
 }
 
 /// The teach scan of the circle from its top, towards y = `towards_y` (+1 or -1), for a 1 mm ball.
