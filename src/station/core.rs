@@ -404,6 +404,7 @@ impl Core {
             let scan = scan_ref(&job.plan, key);
             slot.state = MachineState::Scanning { scan: scan.clone() };
             slot.at = Some(job.scan_start(key));
+            job.last_given.insert(slot.name.clone(), scan.clone());
             tracing::info!(job = %job.info.id, machine = %slot.name, scan = %job.plan.describe(key), "scan started");
             orders.push((slot.name.clone(), Box::new(job.motions[&key].clone()), scan));
         }
@@ -513,11 +514,33 @@ impl Core {
         slot.state = MachineState::LockedOut {
             fault: fault.fault(),
         };
+        let from = slot.at.unwrap_or_else(Point3::origin);
         let Some(job) = self.job.as_mut().filter(|j| j.phase == JobPhase::Running) else {
             return;
         };
-        let reason = format!("part {}: {}", job.info.part, fault.message);
-        let event = stop(job, Some(machine), None, reason, CLEAR_TO_CONTINUE);
+        // The machine is between scans: the profile it scanned last is where its probe is; before its first,
+        // the one it would have been given.
+        let (scan, which) = match job.last_given.get(machine) {
+            Some(last) => (Some(last.clone()), "last"),
+            None => {
+                let next = job
+                    .plan
+                    .nearest(&job.remaining, from, |key| job.scan_start(key))
+                    .map(|index| scan_ref(&job.plan, job.remaining[index]));
+                (next, "next")
+            }
+        };
+        let named = scan
+            .as_ref()
+            .map(|s| {
+                format!(
+                    " (its {which} scan: instance {} profile {})",
+                    s.instance, s.profile
+                )
+            })
+            .unwrap_or_default();
+        let reason = format!("part {}: {}{named}", job.info.part, fault.message);
+        let event = stop(job, Some(machine), scan, reason, CLEAR_TO_CONTINUE);
         self.publish(event);
     }
 

@@ -41,6 +41,8 @@ pub struct Job {
     pub stored: BTreeSet<ProfileKey>,
     /// Profiles already scanned again for a hole in their scan: a second hole stops the job.
     pub rescanned: BTreeSet<ProfileKey>,
+    /// The profile each machine was given last: what a fault seen while it is idle names.
+    pub last_given: BTreeMap<String, ScanRef>,
     pub total: usize,
     pub phase: JobPhase,
 }
@@ -296,6 +298,7 @@ impl Job {
             remaining,
             stored,
             rescanned: BTreeSet::new(),
+            last_given: BTreeMap::new(),
             total: keys.len(),
             phase: JobPhase::Running,
         }

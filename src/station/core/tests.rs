@@ -679,11 +679,53 @@ fn a_machine_found_stopped_at_its_first_look_is_locked_out_and_a_job_waiting_for
     assert!(!touches_a_machine(&effects));
     assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
     assert!(matches!(bench.phase(), JobPhase::Stopped { .. }));
+    // The stop names the profile the machine would have scanned first.
+    let first = bench.core.job().unwrap().plan.nearest(
+        &bench.core.job().unwrap().remaining,
+        Point3::origin(),
+        |key| bench.core.job().unwrap().scan_start(key),
+    );
+    let first = scan_ref(
+        &bench.core.job().unwrap().plan,
+        bench.core.job().unwrap().remaining[first.unwrap()],
+    );
+    assert!(published(
+        &effects,
+        |e| matches!(e, Event::JobStopped { scan: Some(scan), reason, .. }
+        if *scan == first && reason.contains(&format!("its next scan: instance {} profile {}", first.instance, first.profile)))
+    ));
     // Being seen afterwards does not lift the lockout: only a clear does.
     bench.core.handle(Input::Seen {
         machine: MACHINE.into(),
     });
     assert!(matches!(bench.machine(), MachineState::LockedOut { .. }));
+}
+
+#[test]
+fn a_fault_seen_on_a_machine_idle_between_scans_stops_the_job_naming_its_last_scan() {
+    // Every profile of a teach scanned, their files not yet written: the machine is idle, the job still runs.
+    let mut bench = Bench::new();
+    let mut next = scanned(&bench.start_teach());
+    let mut last = None;
+    while let Some(key) = next {
+        last = Some(key);
+        next = scanned(&bench.scan_ended(key, Ok(())));
+    }
+    let last = scan_ref(&bench.core.job().unwrap().plan, last.unwrap());
+    assert_eq!(bench.machine(), MachineState::Idle);
+    assert_eq!(bench.phase(), JobPhase::Running);
+    let effects = bench.core.handle(Input::Observed {
+        machine: MACHINE.into(),
+        fault: estop(),
+    });
+    assert!(!touches_a_machine(&effects));
+    assert!(published(
+        &effects,
+        |e| matches!(e, Event::JobStopped { machine: Some(m), scan: Some(scan), reason, next_step, .. }
+        if m == MACHINE && *scan == last && reason.contains("part propeller")
+            && reason.contains(&format!("its last scan: instance {} profile {}", last.instance, last.profile))
+            && next_step.contains("zeroset clear"))
+    ));
 }
 
 #[test]
