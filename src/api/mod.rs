@@ -156,6 +156,24 @@ pub enum Event {
         /// When the point's line arrived from the machine, microseconds since the Unix epoch.
         received_unix_us: u64,
     },
+    /// A point's deviation the moment it arrives, while its `Point` waits for the four points after it (the
+    /// look-ahead of the probe compensation): compensated from the path up to it, within about a micron of its
+    /// `Point` except where the surface bends sharply within the look-ahead. Live display only: the `Point` that
+    /// follows is the measurement, the one statistics, files and reports hold.
+    PointPreview {
+        job: String,
+        machine: String,
+        scan: ScanRef,
+        index: usize,
+        /// The surface point, machine coordinates, mm.
+        surface_mm: [f64; 3],
+        /// Signed deviation from the reference (mm, positive outside the material); `None` when teaching.
+        deviation_mm: Option<f64>,
+        /// As `Point`'s: the contact is not to be trusted.
+        flagged: bool,
+        /// When the point's line arrived from the machine, microseconds since the Unix epoch.
+        received_unix_us: u64,
+    },
     /// A profile's points are on disk and it counts as done.
     ProfileDone {
         job: String,

@@ -42,6 +42,25 @@ struct InstanceBar {
     bar: ProgressBar,
     stats: RunningStats,
     points: usize,
+    /// The deviation of the newest point previewed, mm.
+    newest_mm: Option<f64>,
+}
+
+impl InstanceBar {
+    /// The bar's message while `profile` is scanned: points so far, their running figures, the newest deviation.
+    fn show_scanning(&self, profile: &str) {
+        let running = self
+            .stats
+            .summary()
+            .map(|s| format!(", mean {:+.4} mm, RMS {:.4} mm", s.mean_mm, s.rms_mm))
+            .unwrap_or_default();
+        let newest = self
+            .newest_mm
+            .map(|d| format!(", now {d:+.4} mm"))
+            .unwrap_or_default();
+        self.bar
+            .set_message(format!("{profile} {} points{running}{newest}", self.points));
+    }
 }
 
 impl Watch {
@@ -73,7 +92,8 @@ impl Watch {
         match event {
             Event::JobStarted { job, done } => self.lay_out(job, done)?,
             Event::ScanStarted { machine, scan, .. } => {
-                if let Some(instance) = self.instances.get(&scan.instance) {
+                if let Some(instance) = self.instances.get_mut(&scan.instance) {
+                    instance.newest_mm = None;
                     instance
                         .bar
                         .set_message(format!("scanning {} on {machine}", scan.profile));
@@ -92,15 +112,18 @@ impl Watch {
                     if let (Some(d), false) = (deviation_mm, flagged) {
                         instance.stats.push(*d, *surface_mm);
                     }
-                    let running = instance
-                        .stats
-                        .summary()
-                        .map(|s| format!(", mean {:+.4} mm, RMS {:.4} mm", s.mean_mm, s.rms_mm))
-                        .unwrap_or_default();
-                    instance.bar.set_message(format!(
-                        "{} {} points{running}",
-                        scan.profile, instance.points
-                    ));
+                    instance.show_scanning(&scan.profile);
+                }
+            }
+            Event::PointPreview {
+                scan,
+                deviation_mm,
+                ..
+            } => {
+                // The newest point's deviation as it arrives; it is counted when its `Point` comes.
+                if let Some(instance) = self.instances.get_mut(&scan.instance) {
+                    instance.newest_mm = *deviation_mm;
+                    instance.show_scanning(&scan.profile);
                 }
             }
             Event::ProfileDone {
@@ -235,6 +258,7 @@ impl Watch {
                     bar,
                     stats: RunningStats::default(),
                     points: 0,
+                    newest_mm: None,
                 },
             );
         }
@@ -281,6 +305,7 @@ fn event_job(event: &Event) -> Option<&str> {
         Event::JobStarted { job, .. } => Some(&job.id),
         Event::ScanStarted { job, .. }
         | Event::Point { job, .. }
+        | Event::PointPreview { job, .. }
         | Event::ProfileDone { job, .. }
         | Event::ProfileRescanned { job, .. }
         | Event::JobStopped { job, .. }

@@ -2,6 +2,8 @@
 //! recorder, which writes it to disk on its own thread; it is compensated for the probe ball from the path of ball
 //! centres around it (`geometry::sweep::compensation`: a point is compensated once the four points after it have
 //! arrived, the last four when the scan ends), measured against the reference (when inspecting) and published.
+//! Until then each point is published at once as a preview, from the path up to it, so the live deviation does
+//! not wait for the machine's next line of points.
 //! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done.
 //! Points whose contact compensation flags (a cusp: the surface more concave than the ball) are published and
 //! recorded but left out of the profile's statistics and verdict, and counted in the log. The queue from the
@@ -159,6 +161,9 @@ impl Pipeline {
                     {
                         self.publish(key, profile, point);
                     }
+                    if let Some(preview) = profile.compensator.preview() {
+                        self.publish_preview(key, profile, preview, received_us);
+                    }
                 }
                 PipelineMsg::End { key } => {
                     if let Some(mut profile) = active.remove(&key) {
@@ -209,6 +214,44 @@ impl Pipeline {
         let _ = self.events.send(event);
     }
 
+    /// Measures the newest point's provisional compensation and publishes it as a preview: nothing is counted.
+    fn publish_preview(
+        &self,
+        key: ProfileKey,
+        profile: &mut Active<'_>,
+        preview: Compensated,
+        received_us: u64,
+    ) {
+        let deviation = self.deviation(key, profile, &preview);
+        let _ = self.events.send(Event::PointPreview {
+            job: self.job.clone(),
+            machine: profile.header.machine.clone(),
+            scan: self.scan_ref(key),
+            index: preview.index,
+            surface_mm: preview.surface.coords.into(),
+            deviation_mm: deviation,
+            flagged: preview.is_flagged(),
+            received_unix_us: received_us,
+        });
+    }
+
+    /// A compensated point's deviation from the reference; `None` when teaching or when it has no foot (logged).
+    fn deviation(
+        &self,
+        key: ProfileKey,
+        profile: &mut Active<'_>,
+        point: &Compensated,
+    ) -> Option<f64> {
+        let gauge = profile.gauge.as_mut()?;
+        match gauge.measure(&(profile.machine_to_part * point.surface)) {
+            Ok(measured) => Some(measured.deviation_mm),
+            Err(error) => {
+                tracing::warn!(job = %self.job, scan = %self.plan.describe(key), index = point.index, %error, "no deviation for a point");
+                None
+            }
+        }
+    }
+
     /// Measures one compensated point; returns its event.
     fn measure(
         &self,
@@ -219,16 +262,7 @@ impl Pipeline {
     ) -> Event {
         let index = point.index;
         let surface = point.surface;
-        let deviation = profile.gauge.as_mut().and_then(|gauge| {
-            let in_part = profile.machine_to_part * surface;
-            match gauge.measure(&in_part) {
-                Ok(measured) => Some(measured.deviation_mm),
-                Err(error) => {
-                    tracing::warn!(job = %self.job, scan = %self.plan.describe(key), index, %error, "no deviation for a point");
-                    None
-                }
-            }
-        });
+        let deviation = self.deviation(key, profile, &point);
         if point.is_flagged() {
             profile.flagged += 1;
         } else if let Some(d) = deviation {
@@ -275,6 +309,7 @@ mod tests {
     use crate::analysis::test_profiles::{taught_ellipses, Ellipse};
     use crate::api::JobKind;
     use crate::config::PartConfig;
+    use crate::geometry::sweep::compensation::LOOK_AHEAD;
     use crate::station::journal::{JobRecord, JobState, PartialScan, ScanFile};
     use crate::station::recorder::{Disk, Partial, RECORDER_QUEUE};
 
@@ -293,12 +328,16 @@ mod tests {
         deviation: Option<f64>,
         flagged: bool,
         received: u64,
+        /// Its place among the point and preview events published.
+        order: usize,
     }
 
     /// What the pipeline published for one scan.
     struct Published {
         /// In the order published.
         points: Vec<PointEvent>,
+        /// The previews, in the order published.
+        previews: Vec<PointEvent>,
         stats: Option<DeviationStats>,
     }
 
@@ -374,11 +413,13 @@ mod tests {
         to_pipeline.send(last(key)).await.unwrap();
         let mut published = Published {
             points: Vec::new(),
+            previews: Vec::new(),
             stats: None,
         };
         let ends_with_done = matches!(last(key), PipelineMsg::End { .. });
+        let mut order = 0;
         while published.points.len() < raws.len() || ends_with_done {
-            match watch.recv().await.unwrap() {
+            let (event, into) = match watch.recv().await.unwrap() {
                 Event::Point {
                     index,
                     surface_mm,
@@ -386,19 +427,37 @@ mod tests {
                     flagged,
                     received_unix_us,
                     ..
-                } => published.points.push(PointEvent {
+                } => (
+                    (index, surface_mm, deviation_mm, flagged, received_unix_us),
+                    &mut published.points,
+                ),
+                Event::PointPreview {
                     index,
-                    surface: surface_mm,
-                    deviation: deviation_mm,
+                    surface_mm,
+                    deviation_mm,
                     flagged,
-                    received: received_unix_us,
-                }),
+                    received_unix_us,
+                    ..
+                } => (
+                    (index, surface_mm, deviation_mm, flagged, received_unix_us),
+                    &mut published.previews,
+                ),
                 Event::ProfileDone { stats, .. } => {
                     published.stats = stats;
                     break;
                 }
-                _ => {}
-            }
+                _ => continue,
+            };
+            let (index, surface, deviation, flagged, received) = event;
+            into.push(PointEvent {
+                index,
+                surface,
+                deviation,
+                flagged,
+                received,
+                order,
+            });
+            order += 1;
         }
         published
     }
@@ -451,11 +510,26 @@ mod tests {
             .collect();
         assert!(!flagged.is_empty());
         assert!(
-            flagged
-                .iter()
-                .all(|i| i.abs_diff(150) <= 3 + crate::geometry::sweep::compensation::LOOK_AHEAD),
+            flagged.iter().all(|i| i.abs_diff(150) <= 3 + LOOK_AHEAD),
             "{flagged:?}"
         );
+        // Every point that waits for its look-ahead is previewed as it arrives, before its point event, and away
+        // from the dent within a micron of it.
+        let previewed: Vec<usize> = published.previews.iter().map(|p| p.index).collect();
+        assert_eq!(previewed, (LOOK_AHEAD..raws.len()).collect::<Vec<_>>());
+        for preview in &published.previews {
+            let point = &published.points[preview.index];
+            assert!(preview.order < point.order, "point {}", preview.index);
+            assert_eq!(preview.received, point.received);
+            if preview.index.abs_diff(150) > 2 * LOOK_AHEAD + 3 {
+                let difference = preview.deviation.unwrap() - point.deviation.unwrap();
+                assert!(
+                    difference.abs() < 1e-3,
+                    "point {}: {difference} mm",
+                    preview.index
+                );
+            }
+        }
         // The dent's bottom is flagged, and still published with its deviation.
         assert!(flagged.contains(&150));
         assert!(published.points[150].deviation.is_some());
@@ -471,9 +545,7 @@ mod tests {
         let off_dent = published
             .points
             .iter()
-            .filter(|p| {
-                p.index.abs_diff(150) > 3 + crate::geometry::sweep::compensation::LOOK_AHEAD
-            })
+            .filter(|p| p.index.abs_diff(150) > 3 + LOOK_AHEAD)
             .map(|p| p.deviation.unwrap().abs())
             .fold(0.0, f64::max);
         assert!(off_dent < 0.01, "{off_dent}");

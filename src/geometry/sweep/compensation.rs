@@ -52,7 +52,10 @@
 //! point is where a circle of radius `rho = r / cos(tilt)` about the centre touches the section curve.
 //!
 //! Streaming: a point is compensated once the K = 4 points after it have arrived. The first and last K points of an
-//! open path have no symmetric window and use the reported normal, as do points where the fit cannot work.
+//! open path have no symmetric window and use the reported normal, as do points where the fit cannot work. Until
+//! then a point has a provisional compensation, from the window that ends at it ([`Compensator::preview`]): a
+//! machine sends its points in lines of several, so the last K of a line would otherwise wait a whole line for
+//! their look-ahead, and the live deviation with them.
 
 use std::collections::VecDeque;
 
@@ -218,8 +221,33 @@ impl Compensator {
         if self.recent.len() < WINDOW {
             return None;
         }
-        let window: [Sample; WINDOW] = std::array::from_fn(|i| self.recent[i]);
-        Some(self.fitted(index - LOOK_AHEAD, &window))
+        Some(self.fitted(index - LOOK_AHEAD, &self.window(), LOOK_AHEAD))
+    }
+
+    /// The newest point's provisional compensation, while its final one waits for the look-ahead: from the
+    /// quartic of the window that ends at it, evaluated at that end (the same nine centres that compensate the
+    /// point four back). `None` when the newest point was compensated as it came (the path's first points) or
+    /// none came yet.
+    ///
+    /// Why it is within a micron of the final one: the end slope of the quartic is noisier (1.94 sigma / h against
+    /// 0.34 sigma / h at the middle), but a slope error `e` moves the contact along the surface by `rho e` and off
+    /// it only by `rho e^2 / 2`: 0.06 um for a 2 mm ball at 0.5 mm spacing and 2 um noise. It differs where the
+    /// surface bends within the look-ahead more than the quartic can extrapolate (a sharp edge, a dent).
+    pub fn preview(&self) -> Option<Compensated> {
+        let newest = self.received.checked_sub(1)?;
+        if newest < LOOK_AHEAD {
+            return None;
+        }
+        if self.recent.len() < WINDOW {
+            let sample = self.recent.back()?;
+            return Some(self.reported(newest, sample, Method::Reported(Fallback::PathEnd)));
+        }
+        Some(self.fitted(newest, &self.window(), WINDOW - 1))
+    }
+
+    /// The last `WINDOW` samples; only called once that many have come.
+    fn window(&self) -> [Sample; WINDOW] {
+        std::array::from_fn(|i| self.recent[i])
     }
 
     /// Ends the path: returns the points still waiting for their look-ahead (the path's end, along the reported
@@ -279,16 +307,18 @@ impl Compensator {
         }
     }
 
-    /// The point in the middle of a full window, from the quartic fit of its centre path.
-    fn fitted(&self, index: usize, window: &[Sample; WINDOW]) -> Compensated {
-        let middle = &window[LOOK_AHEAD];
+    /// The point at `at` of a full window (its middle, or its end for a preview), from the quartic fit of its
+    /// centre path in a frame about that point.
+    fn fitted(&self, index: usize, window: &[Sample; WINDOW], at: usize) -> Compensated {
+        let middle = &window[at];
         let unresolved = Method::Reported(Fallback::Unresolved);
         if window.iter().any(|s| !s.rho.is_finite()) {
             return self.reported(index, middle, unresolved);
         }
         let w = self.plane_normal.into_inner();
         let in_plane = |v: Vector3<f64>| v - w * v.dot(&w);
-        let chord = in_plane(window[LOOK_AHEAD + 1].centre - window[LOOK_AHEAD - 1].centre);
+        // The central-difference chord, or the last step's at the window's end.
+        let chord = in_plane(window[(at + 1).min(WINDOW - 1)].centre - window[at - 1].centre);
         if chord.norm() == 0.0 {
             return self.reported(index, middle, unresolved);
         }
@@ -394,7 +424,7 @@ pub fn compensate_path(
         .map(|i| {
             let window: [Sample; WINDOW] =
                 std::array::from_fn(|j| samples[(i + count + j - LOOK_AHEAD) % count]);
-            compensator.fitted(i, &window)
+            compensator.fitted(i, &window, LOOK_AHEAD)
         })
         .collect()
 }
