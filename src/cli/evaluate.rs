@@ -1,5 +1,6 @@
 //! `zeroset evaluate`: where one measured section lies against its nominal profile model and its form error
-//! once that is removed, by a least-squares or minimum-zone best fit in the section's plane.
+//! once that is removed, by a least-squares or minimum-zone best fit in the section's plane; and the section's
+//! parameters (chord, maximum and edge thicknesses) measured and nominal.
 
 use std::path::PathBuf;
 
@@ -13,11 +14,20 @@ use crate::geometry::distance::ExactDistance;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::ZeroSetSamples;
 use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured, SectionFit};
+use crate::geometry::section_parameters::{section_parameters, SectionParameters};
+use crate::geometry::trace::{simplify_closed, trace_closed_curve};
 use crate::model_file::{ModelFile, ReferenceModel};
 use crate::points::{read_points, PointSet};
 
 /// Zero-set sampling for the exact distance's seeds, as `zeroset deviate` does.
 const CELLS: usize = 512;
+/// The step of the nominal outline's trace, mm: a sharp edge falls between two trace points at most half a step
+/// off its tip (mm).
+const TRACE_STEP_MM: f64 = 0.01;
+/// Enough steps for a section of 2 m round.
+const TRACE_MAX_STEPS: usize = 200_000;
+/// The traced outline is kept within this of itself (mm): dense only where it bends.
+const OUTLINE_TOLERANCE_MM: f64 = 1e-4;
 
 #[derive(Args)]
 pub struct EvaluateArgs {
@@ -36,6 +46,9 @@ pub struct EvaluateArgs {
     /// Each point's deviation as measured and after the fit (CSV), if given.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// How far in from each edge, along the chord, the edge thicknesses are taken (mm).
+    #[arg(long, default_value_t = 2.0)]
+    edge_distance: f64,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -107,6 +120,29 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         pivot.y
     );
     print_fit(&fitted, &chord);
+    let measured = section_parameters(&points, args.edge_distance)
+        .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
+    // The nominal outline: the model's zero set traced through the foot of the first point, at steps fine enough
+    // that the sampling of a sharp edge moves its parameters by under a micron.
+    let nominal = exact
+        .foot(&points[0], None)
+        .map_err(|e| anyhow!("{}: no foot on the model: {e}", args.model.display()))
+        .and_then(|foot| {
+            trace_closed_curve(&model.ip, &foot.point, TRACE_STEP_MM, TRACE_MAX_STEPS).map_err(
+                |e| {
+                    anyhow!(
+                        "{}: its zero set cannot be traced: {e}",
+                        args.model.display()
+                    )
+                },
+            )
+        })
+        .and_then(|traced| {
+            let outline = simplify_closed(&traced, OUTLINE_TOLERANCE_MM);
+            section_parameters(&outline, args.edge_distance)
+                .map_err(|e| anyhow!("{}: {e}", args.model.display()))
+        });
+    print_parameters(&measured, nominal, args.edge_distance);
     if let Some(out) = &args.out {
         write_deviations(out, &points, &fitted)?;
         println!("wrote {}", out.display());
@@ -127,6 +163,53 @@ fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>) {
     );
     print_form("as measured:  ", &fitted.form_before);
     print_form("after the fit:", &fitted.form);
+}
+
+/// One of a section's parameters, read from them.
+type Parameter = fn(&SectionParameters) -> f64;
+
+/// The section's parameters, measured and nominal, with their differences; the nominal's absence said why.
+fn print_parameters(
+    measured: &SectionParameters,
+    nominal: anyhow::Result<SectionParameters>,
+    edge_distance_mm: f64,
+) {
+    println!(
+        "  parameters (leading edge the blunter end, at ({:.3}, {:.3}) mm; edge thicknesses {edge_distance_mm} mm \
+         in from each edge):",
+        measured.leading_edge.x, measured.leading_edge.y
+    );
+    let nominal = match nominal {
+        Ok(nominal) => {
+            println!(
+                "    {:<34} {:>12} {:>12} {:>12}",
+                "", "measured", "nominal", "deviation"
+            );
+            Some(nominal)
+        }
+        Err(error) => {
+            println!("    no nominal parameters: {error:#}");
+            None
+        }
+    };
+    let rows: [(&str, Parameter); 5] = [
+        ("chord (mm)", |p| p.chord_mm),
+        ("max thickness, inscribed (mm)", |p| p.max_thickness_mm),
+        ("  at (fraction of the chord)", |p| p.max_thickness_at),
+        ("leading-edge thickness (mm)", |p| p.le_thickness_mm),
+        ("trailing-edge thickness (mm)", |p| p.te_thickness_mm),
+    ];
+    for (name, value) in rows {
+        let m = value(measured);
+        match &nominal {
+            Some(n) => println!(
+                "    {name:<34} {m:>12.4} {:>12.4} {:>+12.4}",
+                value(n),
+                m - value(n)
+            ),
+            None => println!("    {name:<34} {m:>12.4}"),
+        }
+    }
 }
 
 fn print_form(what: &str, form: &Form) {

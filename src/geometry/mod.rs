@@ -11,6 +11,7 @@ pub mod poly;
 pub mod published;
 pub mod sampling;
 pub(crate) mod section_fit;
+pub(crate) mod section_parameters;
 pub mod small;
 pub mod supershape;
 pub mod sweep;

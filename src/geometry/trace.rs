@@ -69,6 +69,55 @@ pub fn resample_closed(points: &[Vector2<f64>], count: usize) -> Vec<Vector2<f64
     out
 }
 
+/// The vertices of the closed polyline `points` that keep it within `tolerance` of itself (Douglas-Peucker on
+/// each half, split at the vertex farthest from the first): a finely traced curve kept dense only where it bends,
+/// its sharp corners kept exactly.
+pub(crate) fn simplify_closed(points: &[Vector2<f64>], tolerance: f64) -> Vec<Vector2<f64>> {
+    let n = points.len();
+    if n < 4 {
+        return points.to_vec();
+    }
+    let far = (1..n)
+        .max_by(|&a, &b| {
+            (points[a] - points[0])
+                .norm_squared()
+                .total_cmp(&(points[b] - points[0]).norm_squared())
+        })
+        .expect("points");
+    let mut keep = vec![false; n + 1];
+    keep[0] = true;
+    keep[far] = true;
+    keep[n] = true;
+    // The closing vertex is the first one again.
+    let at = |i: usize| points[i % n];
+    let mut stack = vec![(0, far), (far, n)];
+    while let Some((first, last)) = stack.pop() {
+        let (a, b) = (at(first), at(last));
+        let ab = b - a;
+        let length = ab.norm();
+        let off = |i: usize| {
+            let ap = at(i) - a;
+            if length == 0.0 {
+                ap.norm()
+            } else {
+                ab.perp(&ap).abs() / length
+            }
+        };
+        let Some((worst, distance)) = (first + 1..last)
+            .map(|i| (i, off(i)))
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+        else {
+            continue;
+        };
+        if distance > tolerance {
+            keep[worst] = true;
+            stack.push((first, worst));
+            stack.push((worst, last));
+        }
+    }
+    (0..n).filter(|&i| keep[i]).map(|i| points[i]).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,5 +145,61 @@ mod tests {
             .iter()
             .fold((f64::MAX, 0.0f64), |(a, b), g| (a.min(*g), b.max(*g)));
         assert!(hi - lo < 1e-3, "gaps from {lo} to {hi}");
+    }
+
+    /// The distance from `p` to the closed polyline `outline`.
+    fn to_polyline(outline: &[Vector2<f64>], p: &Vector2<f64>) -> f64 {
+        let n = outline.len();
+        (0..n)
+            .map(|i| {
+                let (a, b) = (outline[i], outline[(i + 1) % n]);
+                let t = ((p - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+                (a + (b - a) * t - p).norm()
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn a_simplified_outline_keeps_its_corners_and_stays_within_the_tolerance() {
+        // A square of side 10 mm at 0.01 mm steps is its four corners; a circle of radius 10 mm at 0.01 mm steps
+        // keeps a vertex at least every 0.06 mm (sqrt(8 tol R) = 0.09 mm at best), every point dropped within 0.1 um of what is left.
+        let side: Vec<Vector2<f64>> = (0..1000)
+            .map(|k| Vector2::new(k as f64 * 0.01, 0.0))
+            .collect();
+        let mut square = Vec::new();
+        for turn in 0..4 {
+            let r = nalgebra::Rotation2::new(std::f64::consts::FRAC_PI_2 * turn as f64);
+            let corner = r * Vector2::new(0.0, 0.0)
+                + [
+                    Vector2::zeros(),
+                    Vector2::new(10.0, 0.0),
+                    Vector2::new(10.0, 10.0),
+                    Vector2::new(0.0, 10.0),
+                ][turn];
+            square.extend(side.iter().map(|p| corner + r * p));
+        }
+        let corners = simplify_closed(&square, 1e-4);
+        assert_eq!(corners.len(), 4, "{corners:?}");
+        for c in [
+            Vector2::new(0.0, 0.0),
+            Vector2::new(10.0, 0.0),
+            Vector2::new(10.0, 10.0),
+            Vector2::new(0.0, 10.0),
+        ] {
+            assert!(corners.iter().any(|k| (k - c).norm() < 1e-12), "{c} kept");
+        }
+        let circle: Vec<Vector2<f64>> = (0..6283)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / 6283.0;
+                Vector2::new(10.0 * t.cos(), 10.0 * t.sin())
+            })
+            .collect();
+        let kept = simplify_closed(&circle, 1e-4);
+        assert!((600..1200).contains(&kept.len()), "{} kept", kept.len());
+        let worst = circle
+            .iter()
+            .map(|p| to_polyline(&kept, p))
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-4, "{worst}");
     }
 }

@@ -68,6 +68,40 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
         assert_eq!(written.lines().count(), 401);
         assert!(written.starts_with("y,z,deviation_mm,after_fit_mm\n"));
     }
+    // The section's parameters: a rigid motion leaves them as they are; the master scaled by 1.01 about a point
+    // reads 1 % longer and thicker. The scan's 400 points miss the ends' tips by some 20 um of chord.
+    let scaled = dir.path().join("scaled.csv");
+    let mut text_scaled = String::from("y,z\n");
+    for line in text.lines().skip(1) {
+        let (y, z) = line.split_once(',').unwrap();
+        let (y, z): (f64, f64) = (y.parse().unwrap(), z.parse().unwrap());
+        text_scaled.push_str(&format!(
+            "{},{}\n",
+            100.0 + (y - 100.0) * 1.01,
+            200.0 + (z - 200.0) * 1.01
+        ));
+    }
+    std::fs::write(&scaled, text_scaled).unwrap();
+    for (points, scale) in [(&section, 1.0), (&scaled, 1.01)] {
+        let printed = zeroset_ok(&[
+            "evaluate",
+            "--model",
+            model.to_str().unwrap(),
+            "--points",
+            points.to_str().unwrap(),
+        ]);
+        let chord = numbers_after(&printed, "chord (mm)", 3);
+        let thickness = numbers_after(&printed, "max thickness, inscribed (mm)", 3);
+        assert!(
+            (chord[0] - scale * chord[1]).abs() < 0.03,
+            "chord {chord:?} at scale {scale}:\n{printed}"
+        );
+        assert!(
+            (thickness[0] - scale * thickness[1]).abs() < 0.01,
+            "thickness {thickness:?} at scale {scale}:\n{printed}"
+        );
+        assert!((chord[2] - (chord[0] - chord[1])).abs() < 1e-3);
+    }
     assert!(
         zones[1] <= zones[0] + 1e-4,
         "minimum zone {} mm, L2 {} mm",
