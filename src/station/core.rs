@@ -637,7 +637,12 @@ impl Core {
             job.info.part
         );
         let scan = scan_ref(&job.plan, key);
-        let event = stop(job, None, Some(scan), reason, next_step);
+        let machine = job
+            .last_given
+            .iter()
+            .find(|(_, given)| **given == scan)
+            .map(|(machine, _)| machine.clone());
+        let event = stop(job, machine.as_deref(), Some(scan), reason, next_step);
         self.publish(event);
     }
 

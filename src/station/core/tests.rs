@@ -466,7 +466,7 @@ fn a_job_aborted_while_being_set_up_never_starts() {
 }
 
 #[test]
-fn a_profile_that_cannot_be_stored_stops_the_job() {
+fn a_profile_that_cannot_be_stored_stops_the_job_naming_the_machine_that_scanned_it() {
     let mut bench = Bench::new();
     let key = scanned(&bench.start_teach()).unwrap();
     let job_id = bench.core.job().unwrap().info.id.clone();
@@ -477,7 +477,8 @@ fn a_profile_that_cannot_be_stored_stops_the_job() {
     });
     assert!(published(
         &effects,
-        |e| matches!(e, Event::JobStopped { reason, .. } if reason.contains("No space"))
+        |e| matches!(e, Event::JobStopped { reason, machine: Some(m), scan: Some(_), .. }
+            if reason.contains("No space") && m == MACHINE)
     ));
     // The scan itself ended well: the machine is free, but nothing is dispatched to a stopped job.
     let effects = bench.scan_ended(key, Ok(()));
