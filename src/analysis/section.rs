@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use super::deviation::ProfileGauge;
 use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured};
+use crate::geometry::section_parameters::farthest_pair;
 
 /// The form error after a fit, mm.
 #[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
@@ -110,16 +111,7 @@ fn form(form: &Form) -> SectionForm {
 /// direction pointing to +y (to +z for a chord along z). Taken from the measured points: they lie within the
 /// section's displacement of the reference, which turns the chord by the twist only.
 pub(crate) fn chord_of(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) {
-    let mut best = (0.0, points[0], points[0]);
-    for (i, a) in points.iter().enumerate() {
-        for b in &points[i + 1..] {
-            let d = (a - b).norm_squared();
-            if d > best.0 {
-                best = (d, *a, *b);
-            }
-        }
-    }
-    let (_, a, b) = best;
+    let (a, b) = farthest_pair(points);
     let mut direction = (b - a).try_normalize(0.0).unwrap_or_else(Vector2::x);
     if direction.x < 0.0 || (direction.x == 0.0 && direction.y < 0.0) {
         direction = -direction;

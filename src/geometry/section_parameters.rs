@@ -113,7 +113,7 @@ pub(crate) fn section_parameters(
 }
 
 /// The two points farthest apart (all pairs: a section of a few thousand points takes milliseconds).
-fn farthest_pair(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) {
+pub(crate) fn farthest_pair(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) {
     let mut best = (0.0, points[0], points[0]);
     for (i, a) in points.iter().enumerate() {
         for b in &points[i + 1..] {
