@@ -3,6 +3,8 @@
 
 use nalgebra::{Rotation2, Vector2};
 
+use zeroset_sim::naca::Naca4;
+
 use super::*;
 
 /// `count` points round an ellipse of semi-axes `a` (along x) and `b`, counter-clockwise.
@@ -15,35 +17,14 @@ fn ellipse(a: f64, b: f64, count: usize) -> Vec<Vector2<f64>> {
         .collect()
 }
 
-/// The NACA 4-digit section (chord 100 mm along +x from the nose at the origin; camber `m` at `p`, thickness `t`)
-/// with the closed trailing edge (coefficient -0.1036), `count` points round it from the tail under the section
-/// to the tail over it, denser at the nose (x = c sigma^2).
-fn naca(m: f64, p: f64, t: f64, count: usize) -> Vec<Vector2<f64>> {
-    (0..count)
-        .map(|i| {
-            let sigma = -1.0 + 2.0 * i as f64 / count as f64;
-            let xi = sigma * sigma;
-            let yt = 5.0
-                * t
-                * (0.2969 * xi.sqrt() - 0.1260 * xi - 0.3516 * xi * xi + 0.2843 * xi.powi(3)
-                    - 0.1036 * xi.powi(4));
-            let (yc, slope) = if m == 0.0 {
-                (0.0, 0.0)
-            } else if xi < p {
-                (
-                    m / (p * p) * (2.0 * p * xi - xi * xi),
-                    2.0 * m / (p * p) * (p - xi),
-                )
-            } else {
-                (
-                    m / ((1.0 - p) * (1.0 - p)) * (1.0 - 2.0 * p + 2.0 * p * xi - xi * xi),
-                    2.0 * m / ((1.0 - p) * (1.0 - p)) * (p - xi),
-                )
-            };
-            let angle = slope.atan();
-            let side = if sigma >= 0.0 { 1.0 } else { -1.0 };
-            100.0 * Vector2::new(xi - side * yt * angle.sin(), yc + side * yt * angle.cos())
-        })
+/// The NACA 4-digit section `digits` (chord 100 mm along +x from the nose at the origin, its trailing edge closed),
+/// `count` points round it from the tail, crowding at both edges (the simulator's sections).
+fn naca(digits: &str, count: usize) -> Vec<Vector2<f64>> {
+    Naca4::from_digits(digits, 100.0, true)
+        .unwrap()
+        .points(count)
+        .into_iter()
+        .map(|[x, y]| Vector2::new(x, y))
         .collect()
 }
 
@@ -106,7 +87,7 @@ fn an_ellipses_parameters_are_its_axes_wherever_it_lies_and_however_it_is_turned
 #[test]
 fn a_naca_0012_section_has_its_published_thickness_at_30_percent_and_its_nose_is_the_leading_edge()
 {
-    let outline = moved(&naca(0.0, 0.4, 0.12, 3000), -12.0, Vector2::new(0.0, 250.0));
+    let outline = moved(&naca("0012", 3000), -12.0, Vector2::new(0.0, 250.0));
     let p = section_parameters(&outline, 5.0).unwrap();
     assert!((p.chord_mm - 100.0).abs() < 1e-6, "{}", p.chord_mm);
     // The nose is the blunt end: the leading edge, at the moved origin.
@@ -148,10 +129,15 @@ fn a_naca_0012_section_has_its_published_thickness_at_30_percent_and_its_nose_is
 
 #[test]
 fn a_thinned_section_reads_back_thinner_by_as_much() {
-    // Scaling a NACA 2412's thickness by 0.99 scales its largest inscribed circle by as much: what a thickness
-    // error must show.
-    let nominal = section_parameters(&naca(0.02, 0.4, 0.12, 3000), 5.0).unwrap();
-    let thinner = section_parameters(&naca(0.02, 0.4, 0.12 * 0.99, 3000), 5.0).unwrap();
+    // Scaling a NACA 0012 across its chord by 0.99 scales its thickness, and so its largest inscribed circle, by
+    // as much: what a thickness error must show.
+    let section = naca("0012", 3000);
+    let nominal = section_parameters(&section, 5.0).unwrap();
+    let thinned: Vec<Vector2<f64>> = section
+        .iter()
+        .map(|p| Vector2::new(p.x, 0.99 * p.y))
+        .collect();
+    let thinner = section_parameters(&thinned, 5.0).unwrap();
     let ratio = thinner.max_thickness_mm / nominal.max_thickness_mm;
     assert!((ratio - 0.99).abs() < 2e-4, "{ratio}");
     assert!((thinner.chord_mm - nominal.chord_mm).abs() < 1e-3);
