@@ -183,7 +183,7 @@ impl Plan {
         } else {
             self.upmost(key, nominals)
         };
-        let nominals = nominals[first..]
+        let nominals: Vec<Nominal> = nominals[first..]
             .iter()
             .chain(&nominals[..first])
             .map(|n| Nominal {
@@ -194,13 +194,10 @@ impl Plan {
         let scan = &self.part.scan;
         CurveScan {
             closed: true,
-            nominals,
+            nominals: at_density(&nominals, scan.step_mm, scan.max_angle_deg.to_radians()),
             max_deviation: scan.max_deviation_mm,
             min_radius: scan.min_radius_mm,
-            density: Density::Spacing {
-                max_distance: scan.step_mm,
-                max_angle: scan.max_angle_deg.to_radians(),
-            },
+            density: Density::AtNominals,
         }
     }
 
@@ -350,6 +347,37 @@ impl Plan {
         }
         highest
     }
+}
+
+/// The nominals of a closed curve scan at the scan's density: between two taught nominals farther apart than
+/// `max_distance` mm, or whose normals turn by more than `max_angle` rad, evenly spaced ones are put in (their
+/// normals interpolated). Why the station does it rather than the machine (`ScanOnCurveDensity(Dis, Angle)`):
+/// with `AtNominals` the machine reports exactly one point per nominal, so a scan that comes back a point short
+/// has lost one, however few (a data line of one point lost at a scan's end leaves no hole its spacing shows).
+fn at_density(nominals: &[Nominal], max_distance: f64, max_angle: f64) -> Vec<Nominal> {
+    let n = nominals.len();
+    if n < 3 {
+        return nominals.to_vec();
+    }
+    let mut out = Vec::with_capacity(2 * n);
+    for i in 0..n {
+        let (a, b) = (nominals[i], nominals[(i + 1) % n]);
+        out.push(a);
+        let (pa, pb) = (Vector3::new(a.point.x, a.point.y, a.point.z), Vector3::new(b.point.x, b.point.y, b.point.z));
+        let (na, nb) = (Vector3::new(a.normal.x, a.normal.y, a.normal.z), Vector3::new(b.normal.x, b.normal.y, b.normal.z));
+        let pieces = ((pb - pa).norm() / max_distance)
+            .ceil()
+            .max((na.angle(&nb) / max_angle).ceil())
+            .max(1.0) as usize;
+        for k in 1..pieces {
+            let f = k as f64 / pieces as f64;
+            out.push(Nominal {
+                point: xyz(&(pa + (pb - pa) * f)),
+                normal: xyz(&(na * (1.0 - f) + nb * f).normalize()),
+            });
+        }
+    }
+    out
 }
 
 fn xyz(v: &Vector3<f64>) -> Xyz {

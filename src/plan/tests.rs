@@ -185,6 +185,9 @@ fn the_teach_scan_of_another_instance_turns_its_plane_with_it() {
     assert_near(&scan.start_normal, [0.0, 0.0, 1.0], "start normal");
 }
 
+/// Scan nominals per taught step of [`circle`] at the propeller's scan density (1 mm, 10 deg): ceil(5.18 / 1).
+const PER_STEP: usize = 6;
+
 /// Twelve nominals round a circle of radius 10 in the plane x = 200 about (200, 0, 20), counterclockwise
 /// from +y: the one at 90 degrees (index 3) points straight up.
 fn circle() -> Vec<NominalPoint> {
@@ -205,26 +208,31 @@ fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
     let nominals = circle();
     let scan = plan.curve_scan(key(0, 1), &nominals);
     assert!(scan.closed);
-    assert_eq!(scan.nominals.len(), 12);
+    // Each taught step (30 deg, 5.18 mm) is cut into PER_STEP at the scan's 1 mm: taught nominal k is the
+    // scan's PER_STEP k-th.
+    assert_eq!(scan.nominals.len(), 12 * PER_STEP);
     assert_near(&scan.nominals[0].point, [200.0, 0.0, 30.0], "first point");
     assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
     // Then on round the circle the way it was taught, wrapping past the end of the list.
     let (sin, cos) = 120f64.to_radians().sin_cos();
     assert_near(
-        &scan.nominals[1].point,
+        &scan.nominals[PER_STEP].point,
         [200.0, 10.0 * cos, 20.0 + 10.0 * sin],
         "second",
     );
-    assert_near(&scan.nominals[11].point, nominals[2].point, "last");
+    assert_near(&scan.nominals[11 * PER_STEP].point, nominals[2].point, "last");
     assert_eq!(scan.max_deviation, 3.0);
     assert_eq!(scan.min_radius, 1.0);
-    assert_eq!(
-        scan.density,
-        Density::Spacing {
-            max_distance: 1.0,
-            max_angle: 10f64.to_radians()
-        }
-    );
+    assert_eq!(scan.density, Density::AtNominals);
+    // Between them, points at most 1 mm apart on the chords, normals turning at most 10 deg.
+    let n = scan.nominals.len();
+    for i in 0..n {
+        let (a, b) = (scan.nominals[i], scan.nominals[(i + 1) % n]);
+        assert!((point(&b.point) - point(&a.point)).norm() <= 1.0 + 1e-9, "step {i}");
+        let (na, nb) = (point(&a.normal).coords, point(&b.normal).coords);
+        assert!(na.angle(&nb) <= 10f64.to_radians() + 1e-9, "turn {i}");
+        assert!((na.norm() - 1.0).abs() < 1e-12);
+    }
     let start = plan.scan_start(key(0, 1), Some(&nominals));
     assert!(
         (start - Point3::new(200.0, 0.0, 30.0)).norm() < 1e-9,
@@ -244,8 +252,8 @@ fn a_curve_scan_on_blade_b_turns_points_and_normals() {
         "first point",
     );
     assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
-    // The nominal at 0 degrees, (200, 10, 20) with normal +y, is ninth after the top.
-    let side = scan.nominals[9];
+    // The nominal at 0 degrees, (200, 10, 20) with normal +y, is the ninth taught after the top.
+    let side = scan.nominals[9 * PER_STEP];
     assert_near(
         &side.point,
         [200.0 * cos - 10.0 * sin, 200.0 * sin + 10.0 * cos, 20.0],
@@ -267,9 +275,9 @@ fn a_fixture_turn_that_tilts_nothing_keeps_the_upward_start() {
     let scan = plan.curve_scan(key(2, 0), &circle());
     assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
     let z: Vec<f64> = scan.nominals.iter().map(|n| n.point.z).collect();
-    assert_eq!(z.len(), 12);
+    assert_eq!(z.len(), 12 * PER_STEP);
     assert!(
-        (z[0] - 30.0).abs() < 1e-9 && (z[6] - 10.0).abs() < 1e-9,
+        (z[0] - 30.0).abs() < 1e-9 && (z[6 * PER_STEP] - 10.0).abs() < 1e-9,
         "{z:?}"
     );
 }

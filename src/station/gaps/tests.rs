@@ -27,12 +27,23 @@ const KEY: ProfileKey = ProfileKey {
 };
 
 fn curve_motion(path: KnownPath) -> ScanMotion {
+    curve_motion_at(
+        path,
+        Density::Spacing {
+            max_distance: 1.0,
+            max_angle: 0.2,
+        },
+    )
+}
+
+/// As [`curve_motion`], the machine reporting points at `density`.
+fn curve_motion_at(path: KnownPath, density: Density) -> ScanMotion {
     let scan = Scan::Curve(CurveScan {
         closed: true,
         nominals: Vec::new(),
         max_deviation: 3.0,
         min_radius: 1.0,
-        density: Density::AtNominals,
+        density,
     });
     ScanMotion::plan(KEY, "B r300".into(), scan, path, 5.0, &safety()).unwrap()
 }
@@ -155,6 +166,36 @@ fn a_teach_scan_is_whole_when_its_steps_are_and_it_closes() {
     assert_eq!(find_gap(&motion, &holed, BALL).unwrap().after, Some(59));
     let cut = &whole[..turn - 10];
     assert_eq!(find_gap(&motion, cut, BALL).unwrap().after, Some(turn - 11));
+}
+
+#[test]
+fn a_single_point_lost_anywhere_from_a_scan_at_its_nominals_is_a_gap_there() {
+    // One point per nominal (the station's curve scans), the surface 0.4 mm off the nominal, entered at the top
+    // and at the trailing edge's fan: any one point, or any two together, lost.
+    let path = naca_path(200);
+    for entry in [0, edge(&path, Edge::Trailing)] {
+        let mut path = path.clone();
+        path.entry = entry;
+        let motion = curve_motion_at(path.clone(), Density::AtNominals);
+        let mut whole = centres(&path, 0.4, 1);
+        whole.rotate_left(entry);
+        assert_eq!(find_gap(&motion, &whole, BALL), None);
+        for lost in [1, 2] {
+            for from in [1, 17, 99, 100, 150, whole.len() - lost] {
+                let mut scan = whole.clone();
+                scan.drain(from..from + lost);
+                let gap = find_gap(&motion, &scan, BALL)
+                    .unwrap_or_else(|| panic!("{lost} points lost at {from}"));
+                assert_eq!(gap.after, Some(from - 1), "{lost} lost at {from}: {gap}");
+                assert!(gap.length_mm > 0.0, "{gap}");
+            }
+            let gap = find_gap(&motion, &whole[lost..], BALL).expect("the first points lost");
+            assert_eq!(gap.after, None, "{gap}");
+        }
+        assert!(find_gap(&motion, &[], BALL).is_some());
+        // More points than nominals is no gap.
+        assert_eq!(find_gap(&motion, &centres(&path, 0.4, 2), BALL), None);
+    }
 }
 
 #[test]
