@@ -363,8 +363,14 @@ fn at_density(nominals: &[Nominal], max_distance: f64, max_angle: f64) -> Vec<No
     for i in 0..n {
         let (a, b) = (nominals[i], nominals[(i + 1) % n]);
         out.push(a);
-        let (pa, pb) = (Vector3::new(a.point.x, a.point.y, a.point.z), Vector3::new(b.point.x, b.point.y, b.point.z));
-        let (na, nb) = (Vector3::new(a.normal.x, a.normal.y, a.normal.z), Vector3::new(b.normal.x, b.normal.y, b.normal.z));
+        let (pa, pb) = (
+            Vector3::new(a.point.x, a.point.y, a.point.z),
+            Vector3::new(b.point.x, b.point.y, b.point.z),
+        );
+        let (na, nb) = (
+            Vector3::new(a.normal.x, a.normal.y, a.normal.z),
+            Vector3::new(b.normal.x, b.normal.y, b.normal.z),
+        );
         let pieces = ((pb - pa).norm() / max_distance)
             .ceil()
             .max((na.angle(&nb) / max_angle).ceil())

@@ -220,7 +220,11 @@ fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
         [200.0, 10.0 * cos, 20.0 + 10.0 * sin],
         "second",
     );
-    assert_near(&scan.nominals[11 * PER_STEP].point, nominals[2].point, "last");
+    assert_near(
+        &scan.nominals[11 * PER_STEP].point,
+        nominals[2].point,
+        "last",
+    );
     assert_eq!(scan.max_deviation, 3.0);
     assert_eq!(scan.min_radius, 1.0);
     assert_eq!(scan.density, Density::AtNominals);
@@ -228,7 +232,10 @@ fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
     let n = scan.nominals.len();
     for i in 0..n {
         let (a, b) = (scan.nominals[i], scan.nominals[(i + 1) % n]);
-        assert!((point(&b.point) - point(&a.point)).norm() <= 1.0 + 1e-9, "step {i}");
+        assert!(
+            (point(&b.point) - point(&a.point)).norm() <= 1.0 + 1e-9,
+            "step {i}"
+        );
         let (na, nb) = (point(&a.normal).coords, point(&b.normal).coords);
         assert!(na.angle(&nb) <= 10f64.to_radians() + 1e-9, "turn {i}");
         assert!((na.norm() - 1.0).abs() < 1e-12);

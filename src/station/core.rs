@@ -67,6 +67,12 @@ pub enum Input {
         machine: String,
         result: Result<(), WorkerError>,
     },
+    /// The analysis that ran before the one [`Effect::StartPipeline`] started has ended, every profile it had
+    /// been given stored (or reported not stored); or it has not ended in time, and why.
+    EarlierAnalysisEnded {
+        job: String,
+        result: Result<(), String>,
+    },
     /// A job's reference was fitted or its report written (or not).
     Finished {
         job: String,
@@ -88,7 +94,8 @@ pub enum Effect {
         part: String,
         serial: Option<String>,
     },
-    /// A fresh analysis pipeline for the current job (at its start and when it resumes).
+    /// A fresh analysis pipeline for the current job (at its start and when it resumes); once the one before it
+    /// has ended the shell answers [`Input::EarlierAnalysisEnded`].
     StartPipeline,
     /// The current job's analysis is no longer needed (it is over or finishing).
     StopPipeline,
@@ -208,6 +215,9 @@ impl Core {
             Input::Cleared { machine, result } => self.cleared(&machine, result),
             Input::Seen { machine } => self.seen(&machine),
             Input::Observed { machine, fault } => self.observed(&machine, fault),
+            Input::EarlierAnalysisEnded { job, result } => {
+                self.earlier_analysis_ended(&job, result)
+            }
             Input::Finished { job, result } => self.finished(&job, result),
         }
         self.dispatch();
@@ -385,7 +395,7 @@ impl Core {
         let Some(job) = self.job.as_mut() else {
             return;
         };
-        if job.phase != JobPhase::Running {
+        if job.phase != JobPhase::Running || job.awaiting_earlier_analysis {
             return;
         }
         let mut orders = Vec::new();
@@ -643,6 +653,29 @@ impl Core {
             .find(|(_, given)| **given == scan)
             .map(|(machine, _)| machine.clone());
         let event = stop(job, machine.as_deref(), Some(scan), reason, next_step);
+        self.publish(event);
+    }
+
+    /// The analysis from before a resume has ended: scans are given again. One that does not end is a station
+    /// fault (its recorder stalled, or it failed): the job stops rather than scan beside it.
+    fn earlier_analysis_ended(&mut self, job_id: &str, result: Result<(), String>) {
+        let Some(job) = self.job.as_mut().filter(|j| j.info.id == job_id) else {
+            return;
+        };
+        if !std::mem::take(&mut job.awaiting_earlier_analysis) {
+            return;
+        }
+        let Err(error) = result else {
+            return;
+        };
+        if job.phase != JobPhase::Running {
+            return;
+        }
+        let reason = format!(
+            "the analysis of the scans before the stop did not end: {error}; no scan was given beside it"
+        );
+        let next_step = "check the data folder's disk, then run `zeroset clear`; if this recurs, restart the daemon (the job resumes from the scans on disk)";
+        let event = stop(job, None, None, reason, next_step);
         self.publish(event);
     }
 
@@ -922,6 +955,7 @@ impl Core {
         let resumed = match self.job.as_mut() {
             Some(job) if matches!(job.phase, JobPhase::Stopped { .. }) => {
                 job.phase = JobPhase::Running;
+                job.awaiting_earlier_analysis = true;
                 Some((job.info.clone(), job.done_refs()))
             }
             _ => None,

@@ -19,6 +19,10 @@ use super::DaemonMsg;
 use crate::api::{Event, FaultKind, JobKind, Reply};
 use crate::config::StationConfig;
 
+/// How long a resumed job waits for the analysis from before its stop to store what it was given: a healthy
+/// disk takes milliseconds, a stalled one is a fault worth stopping for.
+const EARLIER_ANALYSIS_LIMIT: std::time::Duration = std::time::Duration::from_secs(30);
+
 pub struct Daemon {
     config: Arc<StationConfig>,
     core: Core,
@@ -29,6 +33,8 @@ pub struct Daemon {
     next_request: RequestId,
     /// The current job's analysis, while its machines scan.
     pipeline: Option<mpsc::Sender<PipelineMsg>>,
+    /// The task of the analysis started last: it may still be storing scans after its queue was let go.
+    analysis: Option<tokio::task::JoinHandle<Result<(), String>>>,
     /// Job records go to disk in the order they were decided, on one thread of their own.
     records: std::sync::mpsc::Sender<(JobDir, JobRecord)>,
 }
@@ -72,6 +78,7 @@ impl Daemon {
             replies: HashMap::new(),
             next_request: 0,
             pipeline: None,
+            analysis: None,
             records,
         })
     }
@@ -249,8 +256,32 @@ impl Daemon {
             events: self.events.clone(),
             daemon: self.to_self.clone(),
         };
-        tokio::spawn(pipeline.run(inbox));
+        // The earlier analysis ends once its last worker lets go of its queue (at a resume every machine has
+        // been cleared, so none still scans into it) and its recorder has written what it was given.
         self.pipeline = Some(points);
+        let earlier = self.analysis.replace(tokio::spawn(pipeline.run(inbox)));
+        let (to_self, job) = (self.to_self.clone(), job.info.id.clone());
+        tokio::spawn(async move {
+            let result = match earlier {
+                None => Ok(()),
+                Some(task) => match tokio::time::timeout(EARLIER_ANALYSIS_LIMIT, task).await {
+                    Ok(Ok(ended)) => ended,
+                    Ok(Err(panic)) => Err(format!(
+                        "it failed ({panic}); this is a bug: report it with the daemon's log"
+                    )),
+                    Err(_) => Err(format!(
+                        "it was still storing scans after {} s",
+                        EARLIER_ANALYSIS_LIMIT.as_secs()
+                    )),
+                },
+            };
+            let _ = to_self
+                .send(DaemonMsg::Input(Input::EarlierAnalysisEnded {
+                    job,
+                    result,
+                }))
+                .await;
+        });
     }
 
     /// Fits the reference or writes the report off the decision task, from the scans on disk.

@@ -43,6 +43,10 @@ pub struct Job {
     pub rescanned: BTreeSet<ProfileKey>,
     /// The profile each machine was given last: what a fault seen while it is idle names.
     pub last_given: BTreeMap<String, ScanRef>,
+    /// Set when the job resumes, while the analysis that ran before its stop may still be storing profiles its
+    /// machines had finished: no scan is given until that analysis has ended, so a profile it stores is known to
+    /// be done and never scanned (and written) a second time beside it.
+    pub awaiting_earlier_analysis: bool,
     pub total: usize,
     pub phase: JobPhase,
 }
@@ -299,6 +303,7 @@ impl Job {
             stored,
             rescanned: BTreeSet::new(),
             last_given: BTreeMap::new(),
+            awaiting_earlier_analysis: false,
             total: keys.len(),
             phase: JobPhase::Running,
         }

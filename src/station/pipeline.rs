@@ -81,8 +81,10 @@ struct Active<'g> {
 }
 
 impl Pipeline {
-    pub async fn run(self, inbox: mpsc::Receiver<PipelineMsg>) {
-        let recorder = Recorder {
+    /// Analyses until every sender of `inbox` is gone, and returns once the recorder has written all it was
+    /// given (an error if its thread panicked).
+    pub async fn run(self, inbox: mpsc::Receiver<PipelineMsg>) -> Result<(), String> {
+        let (recorder, thread) = Recorder {
             job: self.job.clone(),
             dir: self.dir.clone(),
             events: self.events.clone(),
@@ -90,6 +92,10 @@ impl Pipeline {
         }
         .spawn();
         self.analyse(inbox, recorder).await;
+        tokio::task::spawn_blocking(move || thread.join())
+            .await
+            .map_err(|e| e.to_string())?
+            .map_err(|_| "its recorder failed (a bug: report it with the daemon's log)".to_string())
     }
 
     /// The analysis itself, writing through `recorder`.
@@ -638,7 +644,8 @@ mod tests {
             events: pipeline.events.clone(),
             daemon: pipeline.daemon.clone(),
         }
-        .spawn();
+        .spawn()
+        .0;
         let scan = pipeline.scan_ref(KEY);
         let (to_pipeline, inbox) = mpsc::channel(QUEUE_POINTS);
         tokio::spawn(pipeline.analyse(inbox, recorder));

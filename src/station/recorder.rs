@@ -102,14 +102,15 @@ struct Open<P> {
 }
 
 impl<D: Disk> Recorder<D> {
-    /// Starts the recorder's thread; it ends when the sender is dropped and everything sent is written.
-    pub fn spawn(self) -> mpsc::Sender<Record> {
+    /// Starts the recorder's thread; it ends when the sender is dropped and everything sent is written, which
+    /// its handle tells.
+    pub fn spawn(self) -> (mpsc::Sender<Record>, std::thread::JoinHandle<()>) {
         let (records, inbox) = mpsc::channel(RECORDER_QUEUE);
-        std::thread::Builder::new()
+        let thread = std::thread::Builder::new()
             .name(format!("recorder {}", self.job))
             .spawn(move || self.run(inbox))
             .expect("a thread starts");
-        records
+        (records, thread)
     }
 
     fn run(self, mut inbox: mpsc::Receiver<Record>) {

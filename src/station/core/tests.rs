@@ -337,6 +337,10 @@ fn clear_resumes_a_stopped_job_where_it_stopped_and_the_job_then_finishes() {
         e,
         Event::JobResumed { .. }
     )));
+    let effects = bench.core.handle(Input::EarlierAnalysisEnded {
+        job: job_id.clone(),
+        result: Ok(()),
+    });
     assert_eq!(
         scanned(&effects),
         Some(first),
@@ -563,18 +567,74 @@ fn a_profile_stored_after_its_machine_failed_on_the_way_out_is_not_scanned_again
         message: "machine cmm1: GoTo: collision".into(),
     };
     bench.scan_ended(key, Err(collision));
-    bench.core.handle(Input::Stored {
-        job: job_id,
-        key,
-        result: Ok(()),
-    });
     bench.request(Request::Clear);
     let effects = bench.core.handle(Input::Cleared {
         machine: MACHINE.into(),
         result: Ok(()),
     });
+    assert!(effects.iter().any(|e| matches!(e, Effect::StartPipeline)));
+    assert_eq!(
+        scanned(&effects),
+        None,
+        "no scan while the analysis from before the stop may still store one"
+    );
+    // Its recorder stores the scan only now (its disk was slow), then that analysis ends.
+    let effects = bench.core.handle(Input::Stored {
+        job: job_id.clone(),
+        key,
+        result: Ok(()),
+    });
+    assert_eq!(scanned(&effects), None);
+    let effects = bench.core.handle(Input::EarlierAnalysisEnded {
+        job: job_id,
+        result: Ok(()),
+    });
     let next = scanned(&effects).expect("the job continues");
     assert_ne!(next, key, "the stored profile is not scanned again");
+}
+
+#[test]
+fn an_analysis_from_before_the_stop_that_does_not_end_stops_the_resumed_job_before_any_scan() {
+    let mut bench = Bench::new();
+    let key = scanned(&bench.start_teach()).unwrap();
+    let job_id = bench.core.job().unwrap().info.id.clone();
+    bench.scan_ended(key, Err(estop()));
+    bench.request(Request::Clear);
+    bench.core.handle(Input::Cleared {
+        machine: MACHINE.into(),
+        result: Ok(()),
+    });
+    let effects = bench.core.handle(Input::EarlierAnalysisEnded {
+        job: job_id.clone(),
+        result: Err("it was still storing scans after 30 s".into()),
+    });
+    assert_eq!(scanned(&effects), None);
+    assert!(published(&effects, |e| matches!(
+        e,
+        Event::JobStopped { reason, next_step, .. }
+            if reason.contains("still storing scans after 30 s") && next_step.contains("zeroset clear")
+    )));
+    // A second end of it (a late answer) changes nothing; the next clear resumes and waits again.
+    let effects = bench.core.handle(Input::EarlierAnalysisEnded {
+        job: job_id.clone(),
+        result: Ok(()),
+    });
+    assert_eq!(scanned(&effects), None);
+    bench.request(Request::Clear);
+    let effects = bench.core.handle(Input::Cleared {
+        machine: MACHINE.into(),
+        result: Ok(()),
+    });
+    assert_eq!(scanned(&effects), None);
+    let effects = bench.core.handle(Input::EarlierAnalysisEnded {
+        job: job_id,
+        result: Ok(()),
+    });
+    assert_eq!(
+        scanned(&effects),
+        Some(key),
+        "the cut profile is scanned again"
+    );
 }
 
 #[test]
