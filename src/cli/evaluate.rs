@@ -176,8 +176,14 @@ fn print_parameters(
 ) {
     println!(
         "  parameters (leading edge the blunter end, at ({:.3}, {:.3}) mm; edge thicknesses {edge_distance_mm} mm \
-         in from each edge):",
-        measured.leading_edge.x, measured.leading_edge.y
+         in from each edge; camber and chord angle from the mean line, its chord from ({:.3}, {:.3}) to ({:.3}, \
+         {:.3}) mm):",
+        measured.leading_edge.x,
+        measured.leading_edge.y,
+        measured.mean_line.leading_end.x,
+        measured.mean_line.leading_end.y,
+        measured.mean_line.trailing_end.x,
+        measured.mean_line.trailing_end.y
     );
     let nominal = match nominal {
         Ok(nominal) => {
@@ -192,12 +198,17 @@ fn print_parameters(
             None
         }
     };
-    let rows: [(&str, Parameter); 5] = [
+    let rows: [(&str, Parameter); 8] = [
         ("chord (mm)", |p| p.chord_mm),
         ("max thickness, inscribed (mm)", |p| p.max_thickness_mm),
         ("  at (fraction of the chord)", |p| p.max_thickness_at),
         ("leading-edge thickness (mm)", |p| p.le_thickness_mm),
         ("trailing-edge thickness (mm)", |p| p.te_thickness_mm),
+        ("max camber, mean line (mm)", |p| p.mean_line.max_camber_mm),
+        ("  at (fraction of its chord)", |p| {
+            p.mean_line.max_camber_at
+        }),
+        ("chord angle to +y (deg)", |p| p.mean_line.chord_angle_deg),
     ];
     for (name, value) in rows {
         let m = value(measured);

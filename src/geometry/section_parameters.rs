@@ -2,11 +2,11 @@
 //! blade software names them: the chord (nose to tail), the maximum thickness as the diameter of the largest
 //! inscribed circle and where along the chord it lies, and the thickness near each edge.
 //!
-//! Not here yet: the camber and the chord's angle. The chord's length is well conditioned (it is the largest
-//! distance, stationary at its ends), but where its ends lie across a round nose is not: sliding both ends
-//! sideways by d shortens it by only about d^2 / (2 r) for ends of radius r, so a sparse scan of a thick
-//! section (seed 003's profile 3, 400 points) puts the chord line 0.67 mm off its dense nominal's, and the camber
-//! measured from it with it. They need a chord whose ends are found from the mean line instead.
+//! The chord's length is well conditioned (it is the largest distance, stationary at its ends), but where its
+//! ends lie across a round nose is not: sliding both ends sideways by d shortens it by only about d^2 / (2 r) for
+//! ends of radius r, so a sparse scan of a thick section (seed 003's profile 3, 400 points) puts the line between
+//! the two farthest points 0.67 mm off its dense nominal's. The camber and the chord's angle are therefore taken
+//! from the mean line, whose ends are fixed by the faces: see [`MeanLine`].
 //!
 //! Definitions (each measured the same way on the scanned section and on the nominal, so that their differences
 //! are the errors):
@@ -18,6 +18,10 @@
 //! - The maximum thickness: the diameter of the largest circle inside the outline, found as the largest of the
 //!   circles centred on each station's line (every inside point lies on one station's line), refined about the
 //!   best station.
+//! - The mean line: the centres of those circles where they touch both faces; its ends, where it meets the outline;
+//!   the chord line joining them; the maximum camber, the mean line's largest distance from that chord line; the
+//!   chord angle, the chord line's direction in the outline's plane (for a propeller's section in the plane of
+//!   the station's y and z, its angle to the plane of rotation).
 //!
 //! Why written here: the one crate that finds a polygon's largest inscribed circle (polylabel) brings the geo
 //! stack for one function, and the stations' lines give the edge thicknesses besides.
@@ -30,9 +34,20 @@ const EDGE_PROBE: f64 = 0.05;
 const STATIONS: usize = 200;
 /// The golden-section searches stop below this, mm.
 const SEARCH_TOLERANCE_MM: f64 = 1e-7;
+/// Stations along the chord at which the mean line is sampled.
+const MEAN_LINE_STATIONS: usize = 400;
+/// A station's inscribed circle is a point of the mean line when it keeps this fraction of the chord clear of
+/// both ends along the chord: inside an end's own round (a nose of radius r, up to r from its tip) the largest
+/// circle on a station's line touches the round alone, and its centre follows the station's line, not the faces.
+const END_CLEARANCE: f64 = 0.02;
+/// The stretch of the mean line, as a fraction of the chord from its first (last) point, through which a parabola
+/// is fitted and followed out to the edge: long enough that the faces' noise averages out. A NACA 4-digit mean
+/// line is a parabola from the nose to its maximum camber (at 20-70 % of the chord) and from there to the tail,
+/// so the fit holds it exactly there.
+const END_STRETCH: f64 = 0.25;
 
 /// A section's parameters, mm and degrees.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SectionParameters {
     pub leading_edge: Vector2<f64>,
     pub trailing_edge: Vector2<f64>,
@@ -45,6 +60,27 @@ pub(crate) struct SectionParameters {
     pub le_thickness_mm: f64,
     /// ... and in from the trailing edge.
     pub te_thickness_mm: f64,
+    pub mean_line: MeanLine,
+}
+
+/// The mean (camber) line: the centres of the circles inscribed in the section, each touching both faces, from
+/// the leading to the trailing edge (stations whose circles keep [`END_CLEARANCE`] clear of both ends); its ends
+/// are where it meets the outline, followed out as a parabola through its first and last [`END_STRETCH`]. The line joining those ends is the chord line of blade software, from which
+/// camber and chord angle are measured.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct MeanLine {
+    /// Inscribed circles' centres at stations along the chord, leading edge first.
+    pub points: Vec<Vector2<f64>>,
+    pub leading_end: Vector2<f64>,
+    pub trailing_end: Vector2<f64>,
+    /// The largest distance of the mean line from its chord line, + on the side the chord turned +90 deg points
+    /// to (mm) ...
+    pub max_camber_mm: f64,
+    /// ... and where along the chord line, as a fraction of it from the leading end.
+    pub max_camber_at: f64,
+    /// The chord line's direction, leading to trailing end, from the outline's first axis towards its second
+    /// (deg, in (-180, 180]).
+    pub chord_angle_deg: f64,
 }
 
 /// Why a section has no parameters.
@@ -54,6 +90,8 @@ pub(crate) enum ParameterError {
     TooFewPoints(usize),
     #[error("the line across the section {0:.3} mm from its leading edge does not cross both faces: is the outline closed, in order round the section?")]
     OpenAt(f64),
+    #[error("no circle inside the section touches both faces away from its ends (chord {0:.3} mm): it has no mean line")]
+    NoMeanLine(f64),
 }
 
 /// The parameters of the closed outline `outline` (in order round it; the last point joins the first), with the
@@ -101,6 +139,7 @@ pub(crate) fn section_parameters(
         return Err(error);
     }
     let largest_radius_mm = across.inscribed_at(station)?;
+    let mean_line = MeanLine::of(&across, chord_mm)?;
     Ok(SectionParameters {
         leading_edge,
         trailing_edge,
@@ -109,7 +148,124 @@ pub(crate) fn section_parameters(
         max_thickness_at: station / chord_mm,
         le_thickness_mm,
         te_thickness_mm,
+        mean_line,
     })
+}
+
+impl MeanLine {
+    fn of(across: &Across, chord_mm: f64) -> Result<MeanLine, ParameterError> {
+        let clear = END_CLEARANCE * chord_mm;
+        let mut centres = Vec::new();
+        // In the chord's frame: x along the chord from the leading edge, y across it.
+        let mut local = Vec::new();
+        for k in 1..MEAN_LINE_STATIONS {
+            let s = chord_mm * k as f64 / MEAN_LINE_STATIONS as f64;
+            let (centre, radius) = across.inscribed_circle_at(s)?;
+            if s - radius > clear && chord_mm - s - radius > clear {
+                let d = centre - across.origin;
+                centres.push(centre);
+                local.push((d.dot(&across.along), d.dot(&across.normal)));
+            }
+        }
+        let too_few = || ParameterError::NoMeanLine(chord_mm);
+        let (first, last) = match (local.first(), local.last()) {
+            (Some(first), Some(last)) => (first.0, last.0),
+            _ => return Err(too_few()),
+        };
+        let stretch = END_STRETCH * chord_mm;
+        // The mean line's end beyond `from` (its first or last point), the parabola through the points within
+        // the stretch of it followed outward to where it leaves the section.
+        let end = |from: f64, outward: f64| -> Result<Vector2<f64>, ParameterError> {
+            let near: Vec<(f64, f64)> = local
+                .iter()
+                .copied()
+                .filter(|(x, _)| (x - from).abs() <= stretch)
+                .collect();
+            let parabola = fit_parabola(&near).ok_or_else(too_few)?;
+            let at = |x: f64| across.origin + across.along * x + across.normal * parabola(x);
+            let step = 2e-3 * chord_mm * outward;
+            let mut inside = from;
+            let mut outside = None;
+            for k in 1..=500 {
+                let x = from + step * k as f64;
+                if !contains(across.outline, &at(x)) {
+                    outside = Some(x);
+                    break;
+                }
+                inside = x;
+            }
+            let mut outside = outside.ok_or(ParameterError::OpenAt(from))?;
+            while (outside - inside).abs() > SEARCH_TOLERANCE_MM {
+                let middle = (inside + outside) / 2.0;
+                if contains(across.outline, &at(middle)) {
+                    inside = middle;
+                } else {
+                    outside = middle;
+                }
+            }
+            Ok(at((inside + outside) / 2.0))
+        };
+        let leading_end = end(first, -1.0)?;
+        let trailing_end = end(last, 1.0)?;
+        let chord = trailing_end - leading_end;
+        let (along, normal) = (
+            chord.normalize(),
+            Vector2::new(-chord.y, chord.x).normalize(),
+        );
+        let (mut max_camber_mm, mut max_camber_at) = (0.0f64, 0.0);
+        for c in &centres {
+            let camber = (c - leading_end).dot(&normal);
+            if camber.abs() > max_camber_mm.abs() {
+                max_camber_mm = camber;
+                max_camber_at = (c - leading_end).dot(&along) / chord.norm();
+            }
+        }
+        Ok(MeanLine {
+            points: centres,
+            leading_end,
+            trailing_end,
+            max_camber_mm,
+            max_camber_at,
+            chord_angle_deg: chord.y.atan2(chord.x).to_degrees(),
+        })
+    }
+}
+
+/// The least-squares parabola y = a + b x + c x^2 through `points`, as a function; `None` for fewer than three.
+fn fit_parabola(points: &[(f64, f64)]) -> Option<impl Fn(f64) -> f64> {
+    if points.len() < 3 {
+        return None;
+    }
+    // Centred and scaled in x so the normal equations stay well conditioned at any chord.
+    let n = points.len() as f64;
+    let mid = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let scale = points
+        .iter()
+        .map(|p| (p.0 - mid).abs())
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let rows = nalgebra::DMatrix::from_fn(points.len(), 3, |i, j| {
+        ((points[i].0 - mid) / scale).powi(j as i32)
+    });
+    let values = nalgebra::DVector::from_iterator(points.len(), points.iter().map(|p| p.1));
+    let coefficients = rows.svd(true, true).solve(&values, 1e-12).ok()?;
+    Some(move |x: f64| {
+        let t = (x - mid) / scale;
+        coefficients[0] + coefficients[1] * t + coefficients[2] * t * t
+    })
+}
+
+/// Whether `p` lies inside the closed polyline `outline` (crossings of a ray towards +x).
+fn contains(outline: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
+    let n = outline.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (outline[i], outline[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
 }
 
 /// The two points farthest apart (all pairs: a section of a few thousand points takes milliseconds).
@@ -176,14 +332,17 @@ impl<'a> Across<'a> {
 
     /// The radius of the largest circle centred on the station's line inside the outline.
     fn inscribed_at(&self, s: f64) -> Result<f64, ParameterError> {
+        self.inscribed_circle_at(s).map(|(_, radius)| radius)
+    }
+
+    /// The centre and radius of that circle: away from the edges it touches both faces, a point of the mean line.
+    fn inscribed_circle_at(&self, s: f64) -> Result<(Vector2<f64>, f64), ParameterError> {
         let (low, high) = self.faces_at(s)?;
-        let distance = |t: f64| {
-            distance_to_outline(
-                self.outline,
-                &(self.origin + self.along * s + self.normal * t),
-            )
-        };
-        Ok(distance(golden_max(low, high, distance)))
+        let at = |t: f64| self.origin + self.along * s + self.normal * t;
+        let centre = at(golden_max(low, high, |t| {
+            distance_to_outline(self.outline, &at(t))
+        }));
+        Ok((centre, distance_to_outline(self.outline, &centre)))
     }
 }
 

@@ -82,7 +82,28 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
         ));
     }
     std::fs::write(&scaled, text_scaled).unwrap();
-    for (points, scale) in [(&section, 1.0), (&scaled, 1.01)] {
+    // And turned by 0.1 deg (counter-clockwise in y, z) about a point: its chord angle reads 0.1 deg more.
+    let turned = dir.path().join("turned.csv");
+    let mut text_turned = String::from("y,z\n");
+    let (sin, cos) = 0.1f64.to_radians().sin_cos();
+    for line in text.lines().skip(1) {
+        let (y, z) = line.split_once(',').unwrap();
+        let (y, z): (f64, f64) = (
+            y.parse::<f64>().unwrap() - 100.0,
+            z.parse::<f64>().unwrap() - 200.0,
+        );
+        text_turned.push_str(&format!(
+            "{},{}\n",
+            100.0 + y * cos - z * sin,
+            200.0 + y * sin + z * cos
+        ));
+    }
+    std::fs::write(&turned, text_turned).unwrap();
+    for (points, scale, turn) in [
+        (&section, 1.0, 0.0),
+        (&scaled, 1.01, 0.0),
+        (&turned, 1.0, 0.1),
+    ] {
         let printed = zeroset_ok(&[
             "evaluate",
             "--model",
@@ -101,6 +122,18 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
             "thickness {thickness:?} at scale {scale}:\n{printed}"
         );
         assert!((chord[2] - (chord[0] - chord[1])).abs() < 1e-3);
+        // Camber and chord angle from the mean line: the camber scales with the section, the angle turns with it
+        // (the nominal is the model fitted to the master's noisy points, within microns of it).
+        let camber = numbers_after(&printed, "max camber, mean line (mm)", 3);
+        assert!(
+            (camber[0] - scale * camber[1]).abs() < 0.01,
+            "camber {camber:?} at scale {scale}:\n{printed}"
+        );
+        let angle = numbers_after(&printed, "chord angle to +y (deg)", 3);
+        assert!(
+            (angle[2] - turn).abs() < 0.005,
+            "chord angle {angle:?} turned {turn} deg:\n{printed}"
+        );
     }
     assert!(
         zones[1] <= zones[0] + 1e-4,

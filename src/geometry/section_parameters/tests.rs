@@ -156,3 +156,104 @@ fn an_outline_that_is_not_a_section_is_refused_saying_why() {
         "{error}"
     );
 }
+
+/// `outline` with each point moved along its outline normal by Gaussian noise of `sigma` mm.
+fn noisy(outline: &[Vector2<f64>], sigma: f64, seed: u64) -> Vec<Vector2<f64>> {
+    use rand::SeedableRng;
+    use rand_distr::Distribution;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let normal = rand_distr::Normal::new(0.0, sigma).unwrap();
+    let n = outline.len();
+    (0..n)
+        .map(|i| {
+            let tangent = outline[(i + 1) % n] - outline[(i + n - 1) % n];
+            let across = Vector2::new(tangent.y, -tangent.x).normalize();
+            outline[i] + across * normal.sample(&mut rng)
+        })
+        .collect()
+}
+
+#[test]
+fn the_mean_line_of_a_naca_section_is_its_camber_line_wherever_it_lies() {
+    // NACA "mpxx": maximum camber m % of the chord at p tenths, on a mean line from the nose (0, 0) to the tail
+    // (100, 0) mm. The inscribed circles' centres lie on it to within microns (the thickness is laid off normal
+    // to it), the chord angle is the section's turn.
+    for (digits, camber_mm, at) in [
+        ("4412", 4.0, 0.4),
+        ("2412", 2.0, 0.4),
+        ("6409", 6.0, 0.4),
+        ("0012", 0.0, f64::NAN),
+    ] {
+        for (angle, shift) in [(0.0, Vector2::zeros()), (-33.0, Vector2::new(-250.0, 71.0))] {
+            let outline = moved(&naca(digits, 600), angle, shift);
+            let line = section_parameters(&outline, 2.0).unwrap().mean_line;
+            let back = |p: Vector2<f64>| Rotation2::new(-f64::to_radians(angle)) * (p - shift);
+            let case = format!("NACA {digits} turned {angle} deg");
+            assert!(
+                (line.chord_angle_deg - angle).abs() < 0.004,
+                "{case}: {}",
+                line.chord_angle_deg
+            );
+            assert!(
+                (line.max_camber_mm - camber_mm).abs() < 0.005,
+                "{case}: {}",
+                line.max_camber_mm
+            );
+            if camber_mm > 0.0 {
+                assert!(
+                    (line.max_camber_at - at).abs() < 0.005,
+                    "{case}: {}",
+                    line.max_camber_at
+                );
+            }
+            assert!(
+                back(line.leading_end).norm() < 0.01,
+                "{case}: {}",
+                back(line.leading_end)
+            );
+            assert!(
+                (back(line.trailing_end) - Vector2::new(100.0, 0.0)).norm() < 0.001,
+                "{case}"
+            );
+            assert!(
+                line.points.len() > MEAN_LINE_STATIONS * 9 / 10,
+                "{}",
+                line.points.len()
+            );
+        }
+    }
+}
+
+#[test]
+fn noise_of_2_um_moves_the_chord_angle_by_under_3_millidegrees_where_the_two_farthest_points_move_ten_times_more(
+) {
+    // Seed 003's root section (NACA 4412, chord 180 mm) scanned with 400 points against its dense nominal.
+    let scaled = |count| {
+        naca("4412", count)
+            .iter()
+            .map(|p| p * 1.8)
+            .collect::<Vec<_>>()
+    };
+    let dense = scaled(8000);
+    let nominal = section_parameters(&dense, 2.0).unwrap().mean_line;
+    let angle_of = |(a, b): (Vector2<f64>, Vector2<f64>)| (b - a).y.atan2((b - a).x).to_degrees();
+    let farthest_nominal = angle_of(farthest_pair(&dense));
+    let (mut worst, mut worst_farthest) = (0.0f64, 0.0f64);
+    for seed in 0..20 {
+        let outline = noisy(&scaled(400), 0.002, seed);
+        let line = section_parameters(&outline, 2.0).unwrap().mean_line;
+        worst = worst.max((line.chord_angle_deg - nominal.chord_angle_deg).abs());
+        worst_farthest =
+            worst_farthest.max((angle_of(farthest_pair(&outline)) - farthest_nominal).abs());
+        let camber = line.max_camber_mm - nominal.max_camber_mm;
+        assert!(
+            camber.abs() < 0.004,
+            "seed {seed}: camber off by {camber} mm"
+        );
+    }
+    assert!(worst < 0.003, "the chord angle moved by {worst} deg");
+    assert!(
+        worst_farthest > 10.0 * worst,
+        "{worst_farthest} against {worst}"
+    );
+}
