@@ -1,6 +1,7 @@
 //! A blade section's parameters from its closed outline (points in the section plane, in order round it), as
 //! blade software names them: the chord (nose to tail), the maximum thickness as the diameter of the largest
-//! inscribed circle and where along the chord it lies, the thickness near each edge, and the mean line with its camber and chord angle.
+//! inscribed circle and where along the chord it lies, the thickness near each edge, and the mean line with its
+//! camber and chord angle.
 //!
 //! The chord's length is well conditioned (it is the largest distance, stationary at its ends), but where its
 //! ends lie across a round nose is not: sliding both ends sideways by d shortens it by only about d^2 / (2 r) for
