@@ -61,6 +61,7 @@ fn profile(blade: usize, x: f64, shift: f64) -> ProfileReport {
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
+        parameters: None,
         points,
     }
 }

@@ -73,6 +73,17 @@ impl Plan {
         }
     }
 
+    /// The radius of the master's profile plane `profile` about the instances' axis, when that axis is the part's z
+    /// axis through its origin (the profile planes x = r are then the blade's sections at radius r, y their
+    /// tangential direction: what a propeller's pitch is measured in); `None` for any other axis.
+    pub fn profile_radius(&self, profile: usize) -> Option<f64> {
+        let instances = &self.part.instances;
+        let axis = Vector3::from(instances.axis_direction).try_normalize(0.0)?;
+        let about_z = (axis - Vector3::z()).norm() < 1e-12 || (axis + Vector3::z()).norm() < 1e-12;
+        let through_origin = instances.axis_point_mm[0] == 0.0 && instances.axis_point_mm[1] == 0.0;
+        (about_z && through_origin).then(|| self.profile_x(profile))
+    }
+
     /// The part's name.
     pub fn part(&self) -> &str {
         &self.part.name

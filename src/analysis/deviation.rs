@@ -101,6 +101,14 @@ impl ProfileGauge {
         self.x_mm
     }
 
+    /// The profile's own model in its (y, z) plane, when it has one (an IP stack's profile; a solid has none).
+    pub fn profile_model(&self) -> Option<&IpModel<2>> {
+        match &self.model {
+            GaugeModel::Ip { model, .. } => Some(model),
+            GaugeModel::Solid(_) => None,
+        }
+    }
+
     /// A measurer for one scan: keeps the previous point's foot so consecutive points are fast.
     pub fn scan(&self) -> ScanGauge<'_> {
         ScanGauge {

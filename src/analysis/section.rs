@@ -1,13 +1,25 @@
 //! A scanned section's best fit to its reference profile (`geometry::section_fit`), as the report keeps it: where
 //! the section lies (shift along the thickness direction and the chord, and in the plane's own axes; twist) and its
-//! form error once that is removed, by least squares and by minimum zone.
+//! form error once that is removed, by least squares and by minimum zone; and its parameters (chord, thicknesses,
+//! camber, chord angle, pitch) measured beside the nominal's.
 
 use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::deviation::ProfileGauge;
+use crate::geometry::implicit::Implicit;
+use crate::geometry::sampling::project_to_zero_set;
 use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured};
-use crate::geometry::section_parameters::farthest_pair;
+use crate::geometry::section_parameters::{farthest_pair, section_parameters, SectionParameters};
+use crate::geometry::trace::simplify_closed;
+
+/// The spacing of a nominal outline's points before it is thinned, mm: fine enough that its sampling moves the
+/// section's parameters by under a micron.
+const OUTLINE_STEP_MM: f64 = 0.01;
+/// The nominal outline is kept within this of itself (mm): dense only where it bends.
+const OUTLINE_TOLERANCE_MM: f64 = 1e-4;
+/// How far in from each edge, along the chord, the edge thicknesses are taken unless told (mm).
+pub(crate) const EDGE_DISTANCE_MM: f64 = 2.0;
 
 /// The form error after a fit, mm.
 #[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
@@ -117,4 +129,119 @@ pub(crate) fn chord_of(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) 
         direction = -direction;
     }
     ((a + b) / 2.0, direction)
+}
+
+/// The nominal outline along `feet` (points of the model's zero set in order round the section: the feet of a
+/// scan's points): each stretch between neighbours filled in with points of the zero set [`OUTLINE_STEP_MM`] apart
+/// (the chord's points projected onto it), then thinned where it is straight. Why not a trace of the zero set from
+/// one point: at a sharp edge a fitted polynomial's zero set passes close to a spurious branch, which a tracer
+/// steps onto and follows round without ever closing (the propeller's sections with a sharp trailing edge do).
+pub(crate) fn nominal_outline(
+    model: &impl Implicit<2>,
+    feet: &[Vector2<f64>],
+) -> Vec<Vector2<f64>> {
+    let n = feet.len();
+    let mut outline = Vec::new();
+    for i in 0..n {
+        let (a, b) = (feet[i], feet[(i + 1) % n]);
+        outline.push(a);
+        let length = (b - a).norm();
+        let pieces = (length / OUTLINE_STEP_MM).ceil() as usize;
+        for k in 1..pieces {
+            let on_chord = a + (b - a) * (k as f64 / pieces as f64);
+            if let Some(on_model) = project_to_zero_set(model, &on_chord, length) {
+                outline.push(on_model);
+            }
+        }
+    }
+    simplify_closed(&outline, OUTLINE_TOLERANCE_MM)
+}
+
+/// The nominal parameters of a profile: those of its model's outline along the feet of `points` (a scan of it,
+/// part frame, in scan order round it); `Err` says why there are none.
+pub fn nominal_parameters(
+    gauge: &ProfileGauge,
+    points: &[Point3<f64>],
+) -> Result<SectionParameters, String> {
+    let model = gauge
+        .profile_model()
+        .ok_or("the reference is a solid, not a stack of sections")?;
+    let mut measure = gauge.scan();
+    let feet = points
+        .iter()
+        .map(|p| {
+            measure
+                .measure(p)
+                .map(|d| Vector2::new(d.foot[1], d.foot[2]))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    section_parameters(&nominal_outline(model, &feet), EDGE_DISTANCE_MM)
+        .map_err(|e| format!("its nominal: {e}"))
+}
+
+/// One parameter of a section, nominal and measured (in the unit its name gives).
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct ParameterValue {
+    pub nominal: f64,
+    pub measured: f64,
+    /// Measured minus nominal.
+    pub deviation: f64,
+}
+
+impl ParameterValue {
+    fn of(nominal: f64, measured: f64) -> Self {
+        ParameterValue {
+            nominal,
+            measured,
+            deviation: measured - nominal,
+        }
+    }
+}
+
+/// A section's parameters as the report keeps them (`geometry::section_parameters` defines each). Fractions are
+/// of the chord from the leading edge; the chord angle is the mean line's chord to +y in the (y, z) plane.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct SectionParametersReport {
+    /// How far in from each edge the edge thicknesses are taken, mm.
+    pub edge_distance_mm: f64,
+    pub chord_mm: ParameterValue,
+    pub max_thickness_mm: ParameterValue,
+    pub max_thickness_at: ParameterValue,
+    pub le_thickness_mm: ParameterValue,
+    pub te_thickness_mm: ParameterValue,
+    pub max_camber_mm: ParameterValue,
+    pub max_camber_at: ParameterValue,
+    pub chord_angle_deg: ParameterValue,
+    /// The local pitch 2 pi r tan(chord angle), mm: for a propeller's sections (planes at radius r about the hub
+    /// axis z); absent for other parts.
+    pub pitch_mm: Option<ParameterValue>,
+}
+
+/// The parameters of the section scanned as `points` (part frame, in scan order round it, flagged contacts left
+/// out) beside `nominal`'s; `radius_mm` is the section's radius about a propeller's hub axis, if it is one.
+pub fn parameters(
+    nominal: &SectionParameters,
+    points: &[Point3<f64>],
+    radius_mm: Option<f64>,
+) -> Result<SectionParametersReport, String> {
+    let in_plane: Vec<Vector2<f64>> = points.iter().map(|p| Vector2::new(p.y, p.z)).collect();
+    let measured = section_parameters(&in_plane, EDGE_DISTANCE_MM).map_err(|e| e.to_string())?;
+    let value =
+        |read: fn(&SectionParameters) -> f64| ParameterValue::of(read(nominal), read(&measured));
+    let pitch = |p: &SectionParameters, r: f64| {
+        std::f64::consts::TAU * r * p.mean_line.chord_angle_deg.to_radians().tan()
+    };
+    Ok(SectionParametersReport {
+        edge_distance_mm: EDGE_DISTANCE_MM,
+        chord_mm: value(|p| p.chord_mm),
+        max_thickness_mm: value(|p| p.max_thickness_mm),
+        max_thickness_at: value(|p| p.max_thickness_at),
+        le_thickness_mm: value(|p| p.le_thickness_mm),
+        te_thickness_mm: value(|p| p.te_thickness_mm),
+        max_camber_mm: value(|p| p.mean_line.max_camber_mm),
+        max_camber_at: value(|p| p.mean_line.max_camber_at),
+        chord_angle_deg: value(|p| p.mean_line.chord_angle_deg),
+        pitch_mm: radius_mm.map(|r| ParameterValue::of(pitch(nominal, r), pitch(&measured, r))),
+    })
 }

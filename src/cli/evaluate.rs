@@ -8,27 +8,18 @@ use anyhow::{anyhow, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::Vector2;
 
-use crate::analysis::section::chord_of;
+use crate::analysis::section::{chord_of, nominal_outline, EDGE_DISTANCE_MM};
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::ZeroSetSamples;
 use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured, SectionFit};
 use crate::geometry::section_parameters::{section_parameters, SectionParameters};
-use crate::geometry::trace::{simplify_closed, trace_closed_curve};
 use crate::model_file::{ModelFile, ReferenceModel};
 use crate::points::{read_points, PointSet};
 
 /// Zero-set sampling for the exact distance's seeds, as `zeroset deviate` does.
 const CELLS: usize = 512;
-/// The step of the nominal outline's trace, mm: a sharp edge falls between two trace points at most half a step
-/// off its tip (mm).
-const TRACE_STEP_MM: f64 = 0.01;
-/// Enough steps for a section of 2 m round.
-const TRACE_MAX_STEPS: usize = 200_000;
-/// The traced outline is kept within this of itself (mm): dense only where it bends.
-const OUTLINE_TOLERANCE_MM: f64 = 1e-4;
-
 #[derive(Args)]
 pub struct EvaluateArgs {
     /// The nominal: a profile model file written by `zeroset fit ip` from y,z points.
@@ -47,7 +38,7 @@ pub struct EvaluateArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// How far in from each edge, along the chord, the edge thicknesses are taken (mm).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = EDGE_DISTANCE_MM)]
     edge_distance: f64,
 }
 
@@ -122,24 +113,19 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     print_fit(&fitted, &chord);
     let measured = section_parameters(&points, args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
-    // The nominal outline: the model's zero set traced through the foot of the first point, at steps fine enough
-    // that the sampling of a sharp edge moves its parameters by under a micron.
-    let nominal = exact
-        .foot(&points[0], None)
-        .map_err(|e| anyhow!("{}: no foot on the model: {e}", args.model.display()))
-        .and_then(|foot| {
-            trace_closed_curve(&model.ip, &foot.point, TRACE_STEP_MM, TRACE_MAX_STEPS).map_err(
-                |e| {
-                    anyhow!(
-                        "{}: its zero set cannot be traced: {e}",
-                        args.model.display()
-                    )
-                },
+    // The nominal outline: the model's zero set along the points' feet.
+    let nominal = points
+        .iter()
+        .map(|p| exact.foot(p, None).map(|foot| foot.point))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| {
+            anyhow!(
+                "{}: a point has no foot on the model: {e}",
+                args.model.display()
             )
         })
-        .and_then(|traced| {
-            let outline = simplify_closed(&traced, OUTLINE_TOLERANCE_MM);
-            section_parameters(&outline, args.edge_distance)
+        .and_then(|feet| {
+            section_parameters(&nominal_outline(&model.ip, &feet), args.edge_distance)
                 .map_err(|e| anyhow!("{}: {e}", args.model.display()))
         });
     print_parameters(&measured, nominal, args.edge_distance);

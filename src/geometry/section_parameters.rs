@@ -49,7 +49,7 @@ const END_STRETCH: f64 = 0.25;
 
 /// A section's parameters, mm and degrees.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct SectionParameters {
+pub struct SectionParameters {
     pub leading_edge: Vector2<f64>,
     pub trailing_edge: Vector2<f64>,
     pub chord_mm: f64,
@@ -69,7 +69,7 @@ pub(crate) struct SectionParameters {
 /// are where it meets the outline, followed out as a parabola through its first and last [`END_STRETCH`]. The line joining those ends is the chord line of blade software, from which
 /// camber and chord angle are measured.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct MeanLine {
+pub struct MeanLine {
     /// Inscribed circles' centres at stations along the chord, leading edge first.
     pub points: Vec<Vector2<f64>>,
     pub leading_end: Vector2<f64>,

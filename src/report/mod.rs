@@ -18,7 +18,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::section::SectionBestFit;
+use crate::analysis::section::{SectionBestFit, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
@@ -119,6 +119,11 @@ pub struct ProfileReport {
     /// its form once those are removed. Empty in older reports, or where the section could not be fitted.
     #[serde(default)]
     pub best_fits: Vec<SectionBestFit>,
+    /// The section's parameters measured beside its reference's (chord, thicknesses, camber, chord angle, pitch).
+    /// Absent in older reports, for parts whose reference is a solid, or where the section has none (said in the
+    /// daemon's log).
+    #[serde(default)]
+    pub parameters: Option<SectionParametersReport>,
     pub points: Vec<PointRecord>,
 }
 

@@ -49,6 +49,7 @@ fn profile(
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
+        parameters: None,
         points,
     };
     (report, stats, outside)

@@ -3,6 +3,7 @@
 //! emergency stop and a killed daemon, each resumed with no point lost or counted twice; two watchers.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 use std::time::Duration;
 
 use nalgebra::{Point2, Point3, Rotation3, Vector3};
@@ -206,6 +207,63 @@ fn assert_best_fits_recover_the_blade_shifts(report: &zeroset::report::PartRepor
     );
 }
 
+/// The blades of config/sims/propeller.toml are blade A moved along the hub axis: every section's parameters read
+/// as its nominal's within the noise, and the nominal's local pitch is the simulator's 900 mm (NACA 4412 sections
+/// turned by atan(pitch / (2 pi r))).
+fn assert_parameters_read_the_blades_alike(
+    report: &zeroset::report::PartReport,
+    daemon_log: &Path,
+) {
+    let why_none = || {
+        let log = std::fs::read_to_string(daemon_log).unwrap_or_default();
+        log.lines()
+            .filter(|l| l.contains("no parameters"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for instance in &report.instances {
+        for profile in &instance.profiles {
+            let what = format!("blade {} profile {}", instance.name, profile.name);
+            let p = profile
+                .parameters
+                .as_ref()
+                .unwrap_or_else(|| panic!("{what} has no parameters: {}", why_none()));
+            let pitch = p
+                .pitch_mm
+                .unwrap_or_else(|| panic!("{what}: a propeller's section has a pitch"));
+            println!(
+                "{what}: chord {:?}, thickness {:?}, camber {:?}, angle {:?}, pitch {pitch:?}, le {:?}, te {:?}",
+                p.chord_mm, p.max_thickness_mm, p.max_camber_mm, p.chord_angle_deg, p.le_thickness_mm, p.te_thickness_mm
+            );
+            assert!(
+                (pitch.nominal - 900.0).abs() < 0.002 * 900.0,
+                "{what}: nominal pitch {pitch:?}"
+            );
+            // Measured on one run: thickness within 4.2 um, camber 5.9 um, chord angle 2.8 millidegrees, pitch
+            // 0.012 %. The chord and the edge thicknesses hang on the ends, where the degree-8 model is off the
+            // sharp trailing edge and the nose by tens of microns (blade A against its own model: chord -0.110
+            // mm at r200, trailing-edge thickness +0.026 mm): they are held to that, until the reference models
+            // hold at sharp edges.
+            let within = [
+                ("max thickness", p.max_thickness_mm.deviation, 0.006),
+                ("max camber", p.max_camber_mm.deviation, 0.008),
+                ("chord angle (deg)", p.chord_angle_deg.deviation, 0.004),
+                (
+                    "pitch (% of nominal)",
+                    100.0 * pitch.deviation / pitch.nominal,
+                    0.03,
+                ),
+                ("chord", p.chord_mm.deviation, 0.15),
+                ("leading-edge thickness", p.le_thickness_mm.deviation, 0.03),
+                ("trailing-edge thickness", p.te_thickness_mm.deviation, 0.04),
+            ];
+            for (name, deviation, limit) in within {
+                assert!(deviation.abs() < limit, "{what}: {name} off by {deviation}");
+            }
+        }
+    }
+}
+
 #[test]
 fn teach_and_inspect_measure_the_simulated_blade_errors() {
     let station = Station::start("propeller.toml");
@@ -301,6 +359,7 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
     assert_best_fits_recover_the_blade_shifts(&report, &html);
+    assert_parameters_read_the_blades_alike(&report, &station.daemon_log());
     assert!(report.instances[0].verdict.passed(), "blade A passes");
     assert!(!report.instances[1].verdict.passed(), "blade B fails");
     let summary = station.cli_ok(&["report", "SN-1"]);

@@ -81,6 +81,7 @@ fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceRepor
                 stats,
                 verdict,
                 best_fits: Vec::new(),
+                parameters: None,
                 points,
             }
         })

@@ -54,6 +54,7 @@ fn profile(name: &str, x_mm: f64, machine: &str, deviations: [f64; 6]) -> Profil
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
+        parameters: None,
         points,
     }
 }
