@@ -7,6 +7,7 @@ use std::path::Path;
 use super::plots::{deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures};
 use super::summary::{deviation, machine_text, COORDINATE_DECIMALS, DEVIATION_DECIMALS};
 use super::{PartReport, ProfileReport};
+use crate::analysis::section::{ParameterValue, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::fsutil::write_atomically;
 
@@ -43,6 +44,7 @@ fn report_html(report: &PartReport) -> Result<String, PlotError> {
     page.push_str(&instance_table(report));
     page.push_str(&profile_table(report));
     page.push_str(&best_fit_table(report));
+    page.push_str(&parameters_table(report));
     page.push_str(&figures_html(report)?);
     page.push_str("</body>\n</html>\n");
     Ok(page)
@@ -157,6 +159,52 @@ fn best_fit_table(report: &PartReport) -> String {
                 html.push_str("</tr>\n");
             }
         }
+    }
+    html.push_str("</table>\n");
+    html
+}
+
+/// The blade table: one row per section with parameters, each cell the measured value and its deviation from the
+/// nominal. Left out when no section has parameters (a part whose reference is a solid).
+fn parameters_table(report: &PartReport) -> String {
+    let rows: Vec<(&str, &str, &SectionParametersReport)> = report
+        .instances
+        .iter()
+        .flat_map(|i| i.profiles.iter().map(move |p| (i, p)))
+        .filter_map(|(i, p)| Some((i.name.as_str(), p.name.as_str(), p.parameters.as_ref()?)))
+        .collect();
+    let Some(edge_distance_mm) = rows.first().map(|(_, _, p)| p.edge_distance_mm) else {
+        return String::new();
+    };
+    let mut html = format!(
+        "<h2>Section parameters, measured (deviation from nominal)</h2>\n<p>Chord between the two points farthest \
+         apart; maximum thickness the largest inscribed circle; edge thicknesses {edge_distance_mm} mm in from each \
+         edge; camber and chord angle (to the plane of rotation, +y) from the mean line; pitch 2 &pi; r tan(chord \
+         angle).</p>\n<table>\n<tr><th>instance</th><th>profile</th><th>chord</th><th>max thickness</th>\
+         <th>leading-edge thickness</th><th>trailing-edge thickness</th><th>max camber</th><th>chord angle</th>\
+         <th>pitch</th></tr>\n"
+    );
+    let value =
+        |v: &ParameterValue, unit: &str| format!("{:.4} {unit} ({:+.4})", v.measured, v.deviation);
+    for (instance, profile, p) in rows {
+        let cells = [
+            escape(instance),
+            escape(profile),
+            value(&p.chord_mm, "mm"),
+            value(&p.max_thickness_mm, "mm"),
+            value(&p.le_thickness_mm, "mm"),
+            value(&p.te_thickness_mm, "mm"),
+            value(&p.max_camber_mm, "mm"),
+            value(&p.chord_angle_deg, "deg"),
+            p.pitch_mm
+                .as_ref()
+                .map_or_else(|| "-".to_string(), |v| value(v, "mm")),
+        ];
+        html.push_str("<tr>");
+        for cell in cells {
+            write!(html, "<td>{cell}</td>").expect("writing to a String");
+        }
+        html.push_str("</tr>\n");
     }
     html.push_str("</table>\n");
     html
