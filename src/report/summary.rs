@@ -1,9 +1,11 @@
 //! The summary an operator reads at the machine: the part, what it was measured with and against, the tolerance,
-//! and one table row per instance (all its profiles) and per profile.
+//! one table row per instance (all its profiles) and per profile, and for sections with a best fit or parameters
+//! where each lies (its least-squares fit) and how far its parameters are off their nominals.
 
 use std::fmt::Write;
 
 use super::PartReport;
+use crate::analysis::section::SectionParametersReport;
 use crate::analysis::stats::{DeviationStats, Verdict};
 
 /// Deviations are shown to 0.1 um, coordinates to 1 um, in every report people read.
@@ -25,6 +27,20 @@ const COLUMNS: [&str; 11] = [
 ];
 /// The first columns are names, left-aligned; the rest numbers, right-aligned; the verdict is left-aligned.
 const LEFT_ALIGNED: [usize; 3] = [0, 1, 10];
+const SECTION_COLUMNS: [&str; 12] = [
+    "instance",
+    "profile",
+    "dn_mm",
+    "dchord_mm",
+    "twist_deg",
+    "form_rms_mm",
+    "d_chord_mm",
+    "d_thickness_mm",
+    "d_le_mm",
+    "d_te_mm",
+    "d_chord_angle_deg",
+    "d_pitch_%",
+];
 
 /// The summary table as text (also printed by the CLI).
 pub fn summary_text(report: &PartReport) -> String {
@@ -87,8 +103,55 @@ pub fn summary_text(report: &PartReport) -> String {
             ));
         }
     }
-    text.push_str(&table(&rows));
+    text.push_str(&table(&rows, &LEFT_ALIGNED));
+    text.push_str(&sections_text(report));
     text
+}
+
+/// Where each section lies after its least-squares best fit (dn: along the thickness direction, + above; twist
+/// counter-clockwise in y, z) and its parameters' deviations from nominal; empty when no section has either.
+fn sections_text(report: &PartReport) -> String {
+    let mut rows = vec![SECTION_COLUMNS.map(String::from).to_vec()];
+    for instance in &report.instances {
+        for profile in &instance.profiles {
+            let fit = profile.best_fits.iter().find(|f| f.method == "l2");
+            let parameters = profile.parameters.as_ref();
+            if fit.is_none() && parameters.is_none() {
+                continue;
+            }
+            let or_blank = |value: Option<String>| value.unwrap_or_default();
+            let off = |read: fn(&SectionParametersReport) -> f64| {
+                or_blank(parameters.map(|p| deviation(read(p))))
+            };
+            rows.push(vec![
+                instance.name.clone(),
+                profile.name.clone(),
+                or_blank(fit.map(|f| deviation(f.dn_mm))),
+                or_blank(fit.map(|f| deviation(f.dchord_mm))),
+                or_blank(fit.map(|f| format!("{:+.4}", f.rotation_deg))),
+                or_blank(fit.map(|f| format!("{:.DEVIATION_DECIMALS$}", f.form.rms_mm))),
+                off(|p| p.chord_mm.deviation),
+                off(|p| p.max_thickness_mm.deviation),
+                off(|p| p.le_thickness_mm.deviation),
+                off(|p| p.te_thickness_mm.deviation),
+                or_blank(parameters.map(|p| format!("{:+.4}", p.chord_angle_deg.deviation))),
+                or_blank(
+                    parameters
+                        .and_then(|p| p.pitch_mm)
+                        .map(|v| format!("{:+.3}", 100.0 * v.deviation / v.nominal)),
+                ),
+            ]);
+        }
+    }
+    if rows.len() == 1 {
+        return String::new();
+    }
+    format!(
+        "\nsections: least-squares best fit (dn along the thickness, + above; dchord along the chord; twist \
+         counter-clockwise in y, z) and parameters minus nominal (thickness: largest inscribed circle; le, te: edge \
+         thicknesses; pitch in % of nominal)\n{}",
+        table(&rows, &[0, 1])
+    )
 }
 
 fn row(
@@ -146,9 +209,9 @@ fn verdict_text(verdict: &Verdict) -> String {
     }
 }
 
-/// Rows padded to their columns' widths, two spaces apart.
-fn table(rows: &[Vec<String>]) -> String {
-    let widths: Vec<usize> = (0..COLUMNS.len())
+/// Rows padded to their columns' widths, two spaces apart; the columns `left` left-aligned, the rest right.
+fn table(rows: &[Vec<String>], left: &[usize]) -> String {
+    let widths: Vec<usize> = (0..rows[0].len())
         .map(|c| rows.iter().map(|r| r[c].chars().count()).max().unwrap_or(0))
         .collect();
     let mut text = String::new();
@@ -158,7 +221,7 @@ fn table(rows: &[Vec<String>]) -> String {
             .zip(&widths)
             .enumerate()
             .map(|(c, (cell, &width))| {
-                if LEFT_ALIGNED.contains(&c) {
+                if left.contains(&c) {
                     format!("{cell:<width$}")
                 } else {
                     format!("{cell:>width$}")

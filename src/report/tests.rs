@@ -235,3 +235,64 @@ fn reading_names_the_file_and_what_is_wrong() {
         .to_string();
     assert!(error.contains("file-not-folder"), "{error}");
 }
+
+#[test]
+fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_are_off() {
+    use crate::analysis::section::{
+        ParameterValue, SectionBestFit, SectionForm, SectionParametersReport,
+    };
+    let mut report = sample_report();
+    assert!(
+        !summary_text(&report).contains("sections:"),
+        "no section table without fits"
+    );
+    let value = |nominal: f64, measured: f64| ParameterValue {
+        nominal,
+        measured,
+        deviation: measured - nominal,
+    };
+    let profile = &mut report.instances[1].profiles[0];
+    let fit = |method: &str, dn_mm: f64| SectionBestFit {
+        mode: "full".into(),
+        method: method.into(),
+        dn_mm,
+        dchord_mm: 0.0123,
+        shift_mm: [0.0, dn_mm],
+        rotation_deg: -0.0121,
+        chord_direction: [1.0, 0.0],
+        form: SectionForm {
+            min_mm: -0.004,
+            max_mm: 0.004,
+            rms_mm: 0.0021,
+            zone_mm: 0.008,
+        },
+    };
+    profile.best_fits = vec![fit("l2", -0.4012), fit("minzone", -0.3990)];
+    profile.parameters = Some(SectionParametersReport {
+        edge_distance_mm: 2.0,
+        chord_mm: value(172.85, 172.87),
+        max_thickness_mm: value(20.7383, 20.7001),
+        max_thickness_at: value(0.3, 0.301),
+        le_thickness_mm: value(6.4028, 6.3894),
+        te_thickness_mm: value(0.5804, 0.5765),
+        max_camber_mm: value(6.9075, 6.9073),
+        max_camber_at: value(0.4, 0.4),
+        chord_angle_deg: value(55.0768, 55.0475),
+        pitch_mm: Some(value(900.0, 898.2)),
+    });
+    let text = summary_text(&report);
+    let line = text
+        .lines()
+        .skip_while(|l| !l.starts_with("sections:"))
+        .find(|l| l.starts_with("blade-B"))
+        .unwrap_or_else(|| panic!("no section row of blade-B in\n{text}"));
+    let cells: Vec<&str> = line.split_whitespace().collect();
+    assert_eq!(
+        cells,
+        [
+            "blade-B", "p100", "-0.4012", "+0.0123", "-0.0121", "0.0021", "+0.0200", "-0.0382",
+            "-0.0134", "-0.0039", "-0.0293", "-0.200"
+        ],
+        "least squares, not the minimum zone: {line}"
+    );
+}
