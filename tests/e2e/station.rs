@@ -371,6 +371,22 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         summary.contains("mm") && summary.contains(&dir.display().to_string()),
         "{summary}"
     );
+    // The operator reads where each section lies: blade B's r100 below A's, as its least-squares fit says.
+    let b100 = &report.instances[1].profiles[0];
+    let row = summary
+        .lines()
+        .skip_while(|l| !l.starts_with("sections:"))
+        .find(|l| l.starts_with("B ") && l.contains(" r100 "))
+        .unwrap_or_else(|| panic!("no section row of B r100 in\n{summary}"));
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    assert_eq!(
+        cells[2],
+        format!("{:+.4}", b100.best_fits[0].dn_mm),
+        "{row}"
+    );
+    assert!(b100.best_fits[0].dn_mm < -0.2, "below: {row}");
+    let thickness = b100.parameters.as_ref().unwrap().max_thickness_mm.deviation;
+    assert_eq!(cells[7], format!("{thickness:+.4}"), "{row}");
     // The history holds the same numbers, and trends over their extremes (one part: no spread yet, no Cp or
     // Cpk, and a warning).
     let trend = station.cli_ok(&["report", "--trend"]);
