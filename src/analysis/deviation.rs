@@ -6,16 +6,18 @@
 //! scan costs a Newton solve of a few iterations (microseconds). The supershape's distance is shared by every
 //! profile: one solid, sampled once.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::edges::SharpEdge;
 use super::reference::Reference;
+use super::section;
 use crate::geometry::distance::{DistanceError, ExactDistance, Foot};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
+use crate::geometry::section_parameters::SectionParameters;
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::ReferenceModel;
 
@@ -32,6 +34,8 @@ pub struct ProfileGauge {
     name: String,
     x_mm: f64,
     model: GaugeModel,
+    /// The profile's nominal parameters, worked out the first time they are asked for.
+    parameters: OnceLock<Result<SectionParameters, String>>,
 }
 
 /// What a profile's points are measured against.
@@ -41,6 +45,8 @@ enum GaugeModel {
         model: IpModel<2>,
         samples: Box<ZeroSetSamples<2>>,
         edges: Vec<SharpEdge>,
+        /// The taught nominal points in (y, z), in order round the section: where its outline is drawn from.
+        nominals: Vec<Vector2<f64>>,
     },
     /// The reference's solid, the same for every profile.
     Solid(Arc<SolidDistance>),
@@ -59,6 +65,7 @@ impl ProfileGauge {
                     name: reference.profiles[profile].name.clone(),
                     x_mm: reference.profiles[profile].x_mm,
                     model: GaugeModel::Solid(Arc::clone(distance)),
+                    parameters: OnceLock::new(),
                 },
                 None => Self::of_ip_profile(reference, profile),
             })
@@ -88,7 +95,13 @@ impl ProfileGauge {
                 samples: Box::new(ZeroSetSamples::new(&fitted.ip, &bounds, SAMPLING_CELLS)),
                 model: fitted.ip.clone(),
                 edges: taught.edges.clone(),
+                nominals: taught
+                    .nominals
+                    .iter()
+                    .map(|n| Vector2::new(n.point[1], n.point[2]))
+                    .collect(),
             },
+            parameters: OnceLock::new(),
         }
     }
 
@@ -101,12 +114,20 @@ impl ProfileGauge {
         self.x_mm
     }
 
-    /// The profile's own model in its (y, z) plane, when it has one (an IP stack's profile; a solid has none).
-    pub fn profile_model(&self) -> Option<&IpModel<2>> {
-        match &self.model {
-            GaugeModel::Ip { model, .. } => Some(model),
-            GaugeModel::Solid(_) => None,
-        }
+    /// The profile's nominal parameters, from its model's outline along its taught nominal points (worked out once,
+    /// on first asking); `Err` says why it has none.
+    pub fn nominal_parameters(&self) -> Result<&SectionParameters, &str> {
+        self.parameters
+            .get_or_init(|| match &self.model {
+                GaugeModel::Ip {
+                    model, nominals, ..
+                } => section::nominal_parameters(model, nominals),
+                GaugeModel::Solid(_) => {
+                    Err("the reference is a solid, not a stack of sections".into())
+                }
+            })
+            .as_ref()
+            .map_err(String::as_str)
     }
 
     /// A measurer for one scan: keeps the previous point's foot so consecutive points are fast.
@@ -154,6 +175,7 @@ impl ScanGauge<'_> {
                 model,
                 samples,
                 edges,
+                ..
             } => self.measure_in_plane(surface, model, samples, edges),
             GaugeModel::Solid(distance) => {
                 let foot = distance.foot(surface).ok_or(DistanceError::NoFootPoint)?;

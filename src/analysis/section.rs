@@ -18,6 +18,10 @@ use crate::geometry::trace::simplify_closed;
 const OUTLINE_STEP_MM: f64 = 0.01;
 /// The nominal outline is kept within this of itself (mm): dense only where it bends.
 const OUTLINE_TOLERANCE_MM: f64 = 1e-4;
+/// The farthest a nominal outline follows the model away from the taught nominals' polyline, mm: more than the
+/// sagitta between two nominals (2 mm apart on a face of radius 20 mm: 25 um) and the master's noise, far less
+/// than a polynomial's stray at a sharp edge.
+const MODEL_STRAY_MM: f64 = 0.05;
 /// How far in from each edge, along the chord, the edge thicknesses are taken unless told (mm).
 pub(crate) const EDGE_DISTANCE_MM: f64 = 2.0;
 
@@ -131,52 +135,45 @@ pub(crate) fn chord_of(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f64>) 
     ((a + b) / 2.0, direction)
 }
 
-/// The nominal outline along `feet` (points of the model's zero set in order round the section: the feet of a
-/// scan's points): each stretch between neighbours filled in with points of the zero set [`OUTLINE_STEP_MM`] apart
-/// (the chord's points projected onto it), then thinned where it is straight. Why not a trace of the zero set from
-/// one point: at a sharp edge a fitted polynomial's zero set passes close to a spurious branch, which a tracer
-/// steps onto and follows round without ever closing (the propeller's sections with a sharp trailing edge do).
+/// The nominal outline through `nominals` (the taught nominal points, in order round the section): each moved onto
+/// the model's zero set, and the stretch between neighbours filled in with points of it [`OUTLINE_STEP_MM`] apart
+/// (the chord's points projected onto it), then thinned where it is straight. Where the model strays from the
+/// nominals, farther than [`MODEL_STRAY_MM`], the nominals' own polyline is kept: at a sharp edge the polynomial
+/// rounds the apex the master was measured with, and beside it its zero set passes close to a spurious branch
+/// (the propeller's sharp trailing edges: a nominal there projects 0.6 mm away, and a trace of the zero set from
+/// one point steps onto the branch and never closes).
 pub(crate) fn nominal_outline(
     model: &impl Implicit<2>,
-    feet: &[Vector2<f64>],
+    nominals: &[Vector2<f64>],
 ) -> Vec<Vector2<f64>> {
-    let n = feet.len();
+    let onto_model = |p: &Vector2<f64>| {
+        project_to_zero_set(model, p, MODEL_STRAY_MM).filter(|q| (q - p).norm() <= MODEL_STRAY_MM)
+    };
+    let on_model: Vec<Vector2<f64>> = nominals
+        .iter()
+        .map(|p| onto_model(p).unwrap_or(*p))
+        .collect();
+    let n = on_model.len();
     let mut outline = Vec::new();
     for i in 0..n {
-        let (a, b) = (feet[i], feet[(i + 1) % n]);
+        let (a, b) = (on_model[i], on_model[(i + 1) % n]);
         outline.push(a);
-        let length = (b - a).norm();
-        let pieces = (length / OUTLINE_STEP_MM).ceil() as usize;
+        let pieces = ((b - a).norm() / OUTLINE_STEP_MM).ceil() as usize;
         for k in 1..pieces {
             let on_chord = a + (b - a) * (k as f64 / pieces as f64);
-            if let Some(on_model) = project_to_zero_set(model, &on_chord, length) {
-                outline.push(on_model);
-            }
+            outline.push(onto_model(&on_chord).unwrap_or(on_chord));
         }
     }
     simplify_closed(&outline, OUTLINE_TOLERANCE_MM)
 }
 
-/// The nominal parameters of a profile: those of its model's outline along the feet of `points` (a scan of it,
-/// part frame, in scan order round it); `Err` says why there are none.
-pub fn nominal_parameters(
-    gauge: &ProfileGauge,
-    points: &[Point3<f64>],
+/// The nominal parameters of a profile model: those of its outline through its taught nominal points `nominals`
+/// (in the profile's plane, in order round it); `Err` says why there are none.
+pub(crate) fn nominal_parameters(
+    model: &impl Implicit<2>,
+    nominals: &[Vector2<f64>],
 ) -> Result<SectionParameters, String> {
-    let model = gauge
-        .profile_model()
-        .ok_or("the reference is a solid, not a stack of sections")?;
-    let mut measure = gauge.scan();
-    let feet = points
-        .iter()
-        .map(|p| {
-            measure
-                .measure(p)
-                .map(|d| Vector2::new(d.foot[1], d.foot[2]))
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
-    section_parameters(&nominal_outline(model, &feet), EDGE_DISTANCE_MM)
+    section_parameters(&nominal_outline(model, nominals), EDGE_DISTANCE_MM)
         .map_err(|e| format!("its nominal: {e}"))
 }
 

@@ -7,6 +7,7 @@
 
 use std::path::PathBuf;
 
+use crate::analysis::section::{SectionBestFit, SectionParametersReport};
 use serde::{Deserialize, Serialize};
 
 #[doc(hidden)]
@@ -183,6 +184,17 @@ pub enum Event {
         /// Deviation statistics (inspect only).
         stats: Option<DeviationStats>,
         verdict: Option<Verdict>,
+        at_unix_ms: u64,
+    },
+    /// A section evaluated at its profile's end (inspect only, off the points' path: it may come after the next
+    /// profile's first points): where it lies after its best fits (least squares, then minimum zone) and its
+    /// parameters beside the nominal's; either may be missing, the daemon's log saying why.
+    SectionEvaluated {
+        job: String,
+        machine: String,
+        scan: ScanRef,
+        best_fits: Vec<SectionBestFit>,
+        parameters: Option<SectionParametersReport>,
         at_unix_ms: u64,
     },
     /// The job stopped on a fault and waits for `zeroset clear`.

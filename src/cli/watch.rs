@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::analysis::section::{SectionBestFit, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, RunningStats, Verdict};
 use crate::api::{Event, InstanceSummary, JobInfo, JobKind, ScanRef};
 
@@ -145,6 +146,16 @@ impl Watch {
                     "{} {} done on {machine}, {points} points{stats} {verdict}",
                     scan.instance, scan.profile
                 ))?;
+            }
+            Event::SectionEvaluated {
+                scan,
+                best_fits,
+                parameters,
+                ..
+            } => {
+                if let Some(text) = section_line(best_fits, parameters.as_ref()) {
+                    self.line(format!("{} {}: {text}", scan.instance, scan.profile))?;
+                }
             }
             Event::JobStopped {
                 job,
@@ -300,6 +311,41 @@ fn console_is_terminal() -> bool {
     std::io::stderr().is_terminal()
 }
 
+/// A section's evaluation in a line: where its least-squares fit puts it, then its parameters off nominal.
+fn section_line(
+    best_fits: &[SectionBestFit],
+    parameters: Option<&SectionParametersReport>,
+) -> Option<String> {
+    let fit = best_fits.iter().find(|f| f.method == "l2").map(|f| {
+        format!(
+            "lies {:+.4} mm along its thickness and {:+.4} mm along its chord, twist {:+.4} deg, form RMS {:.4} mm",
+            f.dn_mm, f.dchord_mm, f.rotation_deg, f.form.rms_mm
+        )
+    });
+    let parameters = parameters.map(|p| {
+        let pitch = p
+            .pitch_mm
+            .map(|v| format!(", pitch {:+.3} %", 100.0 * v.deviation / v.nominal))
+            .unwrap_or_default();
+        format!(
+            "off nominal: max thickness {:+.4} mm, chord {:+.4} mm, camber {:+.4} mm, chord angle {:+.4} deg{pitch}",
+            p.max_thickness_mm.deviation,
+            p.chord_mm.deviation,
+            p.max_camber_mm.deviation,
+            p.chord_angle_deg.deviation
+        )
+    });
+    match (fit, parameters) {
+        (None, None) => None,
+        (fit, parameters) => Some(
+            fit.into_iter()
+                .chain(parameters)
+                .collect::<Vec<_>>()
+                .join("; "),
+        ),
+    }
+}
+
 fn event_job(event: &Event) -> Option<&str> {
     match event {
         Event::JobStarted { job, .. } => Some(&job.id),
@@ -307,6 +353,7 @@ fn event_job(event: &Event) -> Option<&str> {
         | Event::Point { job, .. }
         | Event::PointPreview { job, .. }
         | Event::ProfileDone { job, .. }
+        | Event::SectionEvaluated { job, .. }
         | Event::ProfileRescanned { job, .. }
         | Event::JobStopped { job, .. }
         | Event::JobResumed { job }

@@ -16,7 +16,6 @@ use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
 use crate::analysis::{fit_sanity, section};
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
-use crate::geometry::section_parameters::SectionParameters;
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
 use crate::plan::Plan;
@@ -178,8 +177,6 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
     let serial = inputs.record.serial.clone().unwrap_or_default();
     let mut machines: BTreeMap<String, MachineUse> = BTreeMap::new();
     let mut instances: Vec<InstanceReport> = Vec::new();
-    // Each profile's nominal parameters, once: its model's outline along the feet of the first scan of it.
-    let mut nominals: BTreeMap<usize, Result<SectionParameters, String>> = BTreeMap::new();
     for (instance, name) in plan.instance_names().iter().enumerate() {
         let mut profiles = Vec::new();
         let mut all = RunningStats::default();
@@ -258,12 +255,9 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no best fit of the section");
                     Vec::new()
                 });
-            let nominal = nominals.entry(key.profile).or_insert_with(|| {
-                section::nominal_parameters(&inputs.gauges[key.profile], &in_part)
-            });
-            let parameters = nominal
-                .as_ref()
-                .map_err(Clone::clone)
+            let parameters = inputs.gauges[key.profile]
+                .nominal_parameters()
+                .map_err(str::to_string)
                 .and_then(|nominal| section::parameters(nominal, &in_part, plan.profile_radius(key.profile)))
                 .map_err(|problem| {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no parameters of the section");

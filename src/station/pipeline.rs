@@ -4,7 +4,8 @@
 //! arrived, the last four when the scan ends), measured against the reference (when inspecting) and published.
 //! Until then each point is published at once as a preview, from the path up to it, so the live deviation does
 //! not wait for the machine's next line of points.
-//! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done.
+//! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done;
+//! an inspected section is then evaluated (best fits, parameters) on a blocking thread and published.
 //! Points whose contact compensation flags (a cusp: the surface more concave than the ball) are published and
 //! recorded but left out of the profile's statistics and verdict, and counted in the log. The queue from the
 //! workers is bounded, so analysis that falls behind slows scanning down rather than losing points; so is the
@@ -21,6 +22,7 @@ use super::journal::{JobDir, ScanHeader};
 use super::recorder::{Record, Recorder};
 use super::DaemonMsg;
 use crate::analysis::deviation::{ProfileGauge, ScanGauge};
+use crate::analysis::section;
 use crate::analysis::stats::{RunningStats, Tolerance};
 use crate::analysis::RawPoint;
 use crate::api::{Event, ScanRef};
@@ -78,6 +80,8 @@ struct Active<'g> {
     outside: usize,
     /// Points kept but left out of the statistics: compensation flagged their contact.
     flagged: usize,
+    /// The compensated points not flagged, part frame, in scan order: the section evaluated at the scan's end.
+    in_part: Vec<Point3<f64>>,
 }
 
 impl Pipeline {
@@ -148,6 +152,7 @@ impl Pipeline {
                             stats: RunningStats::default(),
                             outside: 0,
                             flagged: 0,
+                            in_part: Vec::new(),
                         },
                     );
                 }
@@ -174,6 +179,7 @@ impl Pipeline {
                 PipelineMsg::End { key } => {
                     if let Some(mut profile) = active.remove(&key) {
                         self.publish_rest(key, &mut profile);
+                        self.evaluate_section(key, &mut profile);
                         let stats = profile.stats.summary();
                         let _ = recorder
                             .send(Record::End {
@@ -211,6 +217,47 @@ impl Pipeline {
                 "points kept but left out of the statistics: their contact is not unique (the surface is more concave than the ball there, or the ball's path is tighter than the ball)"
             );
         }
+    }
+
+    /// Evaluates the section of a completed inspect scan on a blocking thread (its best fits and parameters take
+    /// tens of milliseconds, which the next profile's live points must not wait for) and publishes it. A profile's
+    /// nominal parameters are worked out once per job, by its gauge.
+    fn evaluate_section(&self, key: ProfileKey, profile: &mut Active<'_>) {
+        let Some(gauges) = self.gauges.clone() else {
+            return;
+        };
+        let in_part = std::mem::take(&mut profile.in_part);
+        let events = self.events.clone();
+        let (job, machine, scan) = (
+            self.job.clone(),
+            profile.header.machine.clone(),
+            self.scan_ref(key),
+        );
+        let radius = self.plan.profile_radius(key.profile);
+        let described = self.plan.describe(key);
+        tokio::task::spawn_blocking(move || {
+            let gauge = &gauges[key.profile];
+            let best_fits = section::best_fits(gauge, &in_part).unwrap_or_else(|problem| {
+                tracing::warn!(scan = %described, %problem, "live: no best fit of the section");
+                Vec::new()
+            });
+            let parameters = gauge
+                .nominal_parameters()
+                .map_err(str::to_string)
+                .and_then(|nominal| section::parameters(nominal, &in_part, radius))
+                .map_err(|problem| {
+                    tracing::warn!(scan = %described, %problem, "live: no parameters of the section");
+                })
+                .ok();
+            let _ = events.send(Event::SectionEvaluated {
+                job,
+                machine,
+                scan,
+                best_fits,
+                parameters,
+                at_unix_ms: clock::unix_ms(),
+            });
+        });
     }
 
     /// Measures a compensated point and publishes its event.
@@ -271,7 +318,10 @@ impl Pipeline {
         let deviation = self.deviation(key, profile, &point);
         if point.is_flagged() {
             profile.flagged += 1;
-        } else if let Some(d) = deviation {
+        } else {
+            profile.in_part.push(profile.machine_to_part * surface);
+        }
+        if let (Some(d), false) = (deviation, point.is_flagged()) {
             profile.stats.push(d, surface.coords.into());
             if !self.tolerance.contains(d) {
                 profile.outside += 1;
