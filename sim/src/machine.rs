@@ -146,7 +146,9 @@ impl Machine {
                 line.dead_until = None;
                 self.transcript.event("line alive again");
             }
+            let armed = self.controller.armed();
             let due = self.controller.poll(self.clock.machine(now));
+            self.note_fired(armed);
             self.queue(due, &mut line);
             self.send_due(&mut line).await?;
         }
@@ -192,7 +194,10 @@ impl Machine {
                     if let Some(delay) = line.delay_next.take() {
                         line.delaying = Some((command.tag(), delay));
                     }
-                    self.controller.receive(command, now)
+                    let armed = self.controller.armed();
+                    let replies = self.controller.receive(command, now);
+                    self.note_fired(armed);
+                    replies
                 }
                 Err(error) => {
                     self.transcript.event(&format!("bad line: {error}"));
@@ -209,6 +214,25 @@ impl Machine {
                 .collect();
             for fault in firing {
                 self.apply(fault, line);
+            }
+        }
+    }
+
+    /// Notes in the transcript each armed fault that a motion command took since `before`: the moment it fired,
+    /// which may come before its error line and after a second arming (a campaign matches errors to firings).
+    fn note_fired(&mut self, before: Armed) {
+        let now = self.controller.armed();
+        for (was, is, fault) in [
+            (before.collision, now.collision, "Collision"),
+            (before.no_touch, now.no_touch, "NoTouch"),
+            (
+                before.surface_not_found,
+                now.surface_not_found,
+                "SurfaceNotFound",
+            ),
+        ] {
+            if was && !is {
+                self.transcript.event(&format!("fired {fault}"));
             }
         }
     }

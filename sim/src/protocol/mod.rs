@@ -237,6 +237,11 @@ impl Controller {
     }
 
     /// Arms a fault for the next motion command.
+    /// The faults armed and not yet fired.
+    pub fn armed(&self) -> Armed {
+        self.armed
+    }
+
     pub fn arm(&mut self, armed: Armed) {
         self.armed.collision |= armed.collision;
         self.armed.no_touch |= armed.no_touch;

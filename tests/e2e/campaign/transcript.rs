@@ -47,7 +47,9 @@ struct Standing {
     reported: bool,
 }
 
-/// Faults armed on the machine and not yet met (the simulator keeps one of each: arming twice arms once).
+/// Faults the machine fired (`# fired KIND`, logged as a motion command takes an armed fault) whose error has not
+/// been met yet. Not their arming (`# fault KIND`): a scan may take one arming before a second is logged and send
+/// its error after it, and the second then fires on the next scan.
 #[derive(Default)]
 struct Armed {
     collision: bool,
@@ -130,11 +132,11 @@ impl TranscriptWatch {
     }
 
     fn event(&mut self, text: &str, at: f64) -> Option<String> {
-        if text.starts_with("fault Collision") {
+        if text.starts_with("fired Collision") {
             self.armed.collision = true;
-        } else if text.starts_with("fault NoTouch") {
+        } else if text.starts_with("fired NoTouch") {
             self.armed.no_touch = true;
-        } else if text.starts_with("fault SurfaceNotFound") {
+        } else if text.starts_with("fired SurfaceNotFound") {
             self.armed.surface_not_found = true;
         } else if text == "line alive again" {
             self.count(Kind::Disconnect);
@@ -385,9 +387,36 @@ mod tests {
     }
 
     #[test]
+    fn a_fault_armed_again_after_a_scan_took_the_first_explains_the_next_scans_error() {
+        // The campaign's SN-C0059: armed, a scan takes it, armed again before that scan's error is sent.
+        let (_, found, _dir) = watch(&[
+            "1.0 # fault SurfaceNotFound",
+            "1.1 < 00098 ScanOnCurve(1,2,3)",
+            "1.11 # fired SurfaceNotFound",
+            "1.12 # fault SurfaceNotFound",
+            "1.13 > 00098 ! Error(2, 1006, \"ScanOnCurve\", \"Surface not found\")",
+            "1.2 < 00099 ClearAllErrors()",
+            "1.3 < 00114 ScanOnCurve(1,2,3)",
+            "1.31 # fired SurfaceNotFound",
+            "1.32 > 00114 ! Error(2, 1006, \"ScanOnCurve\", \"Surface not found\")",
+            "1.4 < 00115 ClearAllErrors()",
+            "1.5 < 00116 ScanOnCurve(1,2,3)",
+            "1.52 > 00116 ! Error(2, 1006, \"ScanOnCurve\", \"Surface not found\")",
+        ]);
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert!(
+            found[0].starts_with("a scan that found no surface that no injected fault explains")
+                && found[0].contains("00116"),
+            "{}",
+            found[0]
+        );
+    }
+
+    #[test]
     fn injected_faults_are_counted_and_an_unexplained_collision_is_a_violation() {
         let (mut watch, found, dir) = watch(&[
             "1.0 # fault Collision",
+            "1.05 # fired Collision",
             "1.1 > 00003 ! Error(3, 2504, \"GoTo\", \"Collision\")",
             "1.2 < 00004 ClearAllErrors()",
             "1.3 > \\xFF\\xFE\\x00\\x1B[0m#!garbage\\x07",
