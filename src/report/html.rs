@@ -152,11 +152,7 @@ fn best_fit_table(report: &PartReport) -> String {
                     format!("{:.DEVIATION_DECIMALS$} mm", f.rms_mm),
                     format!("{:.DEVIATION_DECIMALS$} mm", f.zone_mm),
                 ];
-                html.push_str("<tr>");
-                for cell in cells {
-                    write!(html, "<td>{cell}</td>").expect("writing to a String");
-                }
-                html.push_str("</tr>\n");
+                html.push_str(&cells_row(cells));
             }
         }
     }
@@ -200,13 +196,19 @@ fn parameters_table(report: &PartReport) -> String {
                 .as_ref()
                 .map_or_else(|| "-".to_string(), |v| value(v, "mm")),
         ];
-        html.push_str("<tr>");
-        for cell in cells {
-            write!(html, "<td>{cell}</td>").expect("writing to a String");
-        }
-        html.push_str("</tr>\n");
+        html.push_str(&cells_row(cells));
     }
     html.push_str("</table>\n");
+    html
+}
+
+/// A table row of plain cells, already escaped or formatted.
+fn cells_row(cells: impl IntoIterator<Item = String>) -> String {
+    let mut html = String::from("<tr>");
+    for cell in cells {
+        write!(html, "<td>{cell}</td>").expect("writing to a String");
+    }
+    html.push_str("</tr>\n");
     html
 }
 

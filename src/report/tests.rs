@@ -238,19 +238,12 @@ fn reading_names_the_file_and_what_is_wrong() {
 
 #[test]
 fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_are_off() {
-    use crate::analysis::section::{
-        ParameterValue, SectionBestFit, SectionForm, SectionParametersReport,
-    };
+    use crate::analysis::section::{SectionBestFit, SectionForm};
     let mut report = sample_report();
     assert!(
         !summary_text(&report).contains("sections:"),
         "no section table without fits"
     );
-    let value = |nominal: f64, measured: f64| ParameterValue {
-        nominal,
-        measured,
-        deviation: measured - nominal,
-    };
     let profile = &mut report.instances[1].profiles[0];
     let fit = |method: &str, dn_mm: f64| SectionBestFit {
         mode: "full".into(),
@@ -268,18 +261,7 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
         },
     };
     profile.best_fits = vec![fit("l2", -0.4012), fit("minzone", -0.3990)];
-    profile.parameters = Some(SectionParametersReport {
-        edge_distance_mm: 2.0,
-        chord_mm: value(172.85, 172.87),
-        max_thickness_mm: value(20.7383, 20.7001),
-        max_thickness_at: value(0.3, 0.301),
-        le_thickness_mm: value(6.4028, 6.3894),
-        te_thickness_mm: value(0.5804, 0.5765),
-        max_camber_mm: value(6.9075, 6.9073),
-        max_camber_at: value(0.4, 0.4),
-        chord_angle_deg: value(55.0768, 55.0475),
-        pitch_mm: Some(value(900.0, 898.2)),
-    });
+    profile.parameters = Some(sample_parameters());
     let text = summary_text(&report);
     let line = text
         .lines()
@@ -291,8 +273,31 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
         cells,
         [
             "blade-B", "p100", "-0.4012", "+0.0123", "-0.0121", "0.0021", "+0.0200", "-0.0382",
-            "-0.0134", "-0.0039", "-0.0293", "-0.200"
+            "-0.0134", "-0.0039", "-0.0293", "-0.142"
         ],
         "least squares, not the minimum zone: {line}"
     );
+}
+
+/// A blade section's parameters as a report holds them: B r100 of the simulator's propeller, made thinner and
+/// turned (deviations -0.0382 mm of thickness, -0.0293 deg of chord angle, -1.2770 mm of pitch).
+pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParametersReport {
+    use crate::analysis::section::ParameterValue;
+    let value = |nominal: f64, measured: f64| ParameterValue {
+        nominal,
+        measured,
+        deviation: measured - nominal,
+    };
+    crate::analysis::section::SectionParametersReport {
+        edge_distance_mm: 2.0,
+        chord_mm: value(172.85, 172.87),
+        max_thickness_mm: value(20.7383, 20.7001),
+        max_thickness_at: value(0.3, 0.301),
+        le_thickness_mm: value(6.4028, 6.3894),
+        te_thickness_mm: value(0.5804, 0.5765),
+        max_camber_mm: value(6.9075, 6.9073),
+        max_camber_at: value(0.4, 0.4),
+        chord_angle_deg: value(55.0768, 55.0475),
+        pitch_mm: Some(value(899.897, 898.62)),
+    }
 }

@@ -298,24 +298,7 @@ fn the_blade_table_shows_each_sections_parameters_measured_and_off_nominal() {
         !html.contains("Section parameters"),
         "no table without parameters"
     );
-    let value = |nominal: f64, measured: f64| ParameterValue {
-        nominal,
-        measured,
-        deviation: measured - nominal,
-    };
-    let b = &mut report.instances[1].profiles[0];
-    b.parameters = Some(SectionParametersReport {
-        edge_distance_mm: 2.0,
-        chord_mm: value(172.85, 172.87),
-        max_thickness_mm: value(20.7383, 20.7001),
-        max_thickness_at: value(0.3, 0.301),
-        le_thickness_mm: value(6.4028, 6.3894),
-        te_thickness_mm: value(0.5804, 0.5765),
-        max_camber_mm: value(6.9075, 6.9073),
-        max_camber_at: value(0.4, 0.4),
-        chord_angle_deg: value(55.0768, 55.0475),
-        pitch_mm: Some(value(899.897, 898.62)),
-    });
+    report.instances[1].profiles[0].parameters = Some(crate::report::tests::sample_parameters());
     let html = report_html(&report).unwrap();
     for cell in [
         "<td>B</td><td>r100</td><td>172.8700 mm (+0.0200)</td><td>20.7001 mm (-0.0382)</td>",
