@@ -5,7 +5,7 @@
 //! Until then each point is published at once as a preview, from the path up to it, so the live deviation does
 //! not wait for the machine's next line of points.
 //! When a profile's scan ends the recorder writes its scan file, and only then does the profile count as done;
-//! an inspected section is then evaluated (best fits, parameters) on a blocking thread and published.
+//! meanwhile an inspected section is evaluated (best fits, parameters) on a blocking thread and published.
 //! Points whose contact compensation flags (a cusp: the surface more concave than the ball) are published and
 //! recorded but left out of the profile's statistics and verdict, and counted in the log. The queue from the
 //! workers is bounded, so analysis that falls behind slows scanning down rather than losing points; so is the
