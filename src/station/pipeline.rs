@@ -80,7 +80,8 @@ struct Active<'g> {
     outside: usize,
     /// Points kept but left out of the statistics: compensation flagged their contact.
     flagged: usize,
-    /// The compensated points not flagged, part frame, in scan order: the section evaluated at the scan's end.
+    /// The compensated points not flagged, part frame, in scan order: the section evaluated at the scan's end
+    /// (inspect only; a teach scan keeps none).
     in_part: Vec<Point3<f64>>,
 }
 
@@ -318,7 +319,7 @@ impl Pipeline {
         let deviation = self.deviation(key, profile, &point);
         if point.is_flagged() {
             profile.flagged += 1;
-        } else {
+        } else if profile.gauge.is_some() {
             profile.in_part.push(profile.machine_to_part * surface);
         }
         if let (Some(d), false) = (deviation, point.is_flagged()) {
