@@ -14,7 +14,7 @@ pub trait ClosedCurve: Send + Sync {
 
 /// Samples per curve for the coarse nearest-point search. The curves crowd their parameter where they
 /// bend (cosine spacing at a blade's edges), so this many keeps the refined search on the right arc.
-const SAMPLES: usize = 720;
+pub(crate) const SAMPLES: usize = 720;
 
 /// Parameter step of the tangent's central difference.
 const TANGENT_STEP: f64 = 1e-7;
@@ -45,6 +45,13 @@ impl<C: ClosedCurve> SampledCurve<C> {
         let samples = (0..SAMPLES)
             .map(|i| curve.point(sample_parameter(i)))
             .collect();
+        SampledCurve { curve, samples }
+    }
+
+    /// The curve with its samples computed by the caller: `samples[i]` must be `curve.point(sample_parameter(i))`
+    /// for i below [`SAMPLES`] (a caller that places them from stored parts saves the curve's evaluation).
+    pub(crate) fn with_samples(curve: C, samples: Vec<Point2<f64>>) -> Self {
+        debug_assert_eq!(samples.len(), SAMPLES);
         SampledCurve { curve, samples }
     }
 
@@ -113,7 +120,7 @@ impl<C: ClosedCurve> SampledCurve<C> {
 }
 
 /// Samples sit half a step off the grid, so that none lands on a curve's corner at s = 0.
-fn sample_parameter(i: usize) -> f64 {
+pub(crate) fn sample_parameter(i: usize) -> f64 {
     (i as f64 + 0.5) / SAMPLES as f64
 }
 

@@ -16,12 +16,12 @@ use std::sync::Arc;
 use nalgebra::{Isometry3, Point2, Point3, Vector2, Vector3};
 use serde::Deserialize;
 
-use super::curve::{ClosedCurve, CurvePoint, Nearest, SampledCurve};
+use super::curve::{sample_parameter, ClosedCurve, CurvePoint, Nearest, SampledCurve, SAMPLES};
 use super::{
     parallel, prism_nearest, AnyCurve, Frame, Part, Plane, PlaneNearest, Pose, Section,
     SurfacePoint,
 };
-use crate::naca::Naca4;
+use crate::naca::{FoilStation, Naca4};
 
 /// The propeller as configured (`kind = "propeller"` in config/sims/*.toml).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -48,7 +48,8 @@ pub struct PropellerSpec {
     pub pose: Pose,
 }
 
-/// A blade's manufacturing error, each value given at the root and at the tip.
+/// A blade's manufacturing error, each pair given at the root and at the tip (linear between); each key but
+/// `shift_mm` and `twist_deg` may be left out for no error.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BladeError {
@@ -56,6 +57,27 @@ pub struct BladeError {
     pub shift_mm: [f64; 2],
     /// Extra turn of the section about its mid-chord.
     pub twist_deg: [f64; 2],
+    /// The section's thickness (in mm) times this: 1.02 is 2 % thick.
+    #[serde(default = "no_scale")]
+    pub thickness_scale: [f64; 2],
+    /// The chord's length times this, the thickness and camber in mm kept (the section stretched along its chord).
+    #[serde(default = "no_scale")]
+    pub chord_scale: [f64; 2],
+    /// The mean line's camber (in mm) times this.
+    #[serde(default = "no_scale")]
+    pub camber_scale: [f64; 2],
+    /// The geometric pitch that sets the blade angle, off by this percentage.
+    #[serde(default)]
+    pub pitch_error_pct: [f64; 2],
+    /// The whole blade turned by this about the hub axis (counter-clockwise seen from +z), deg: an error of the
+    /// angular spacing of the blades. A blade turned off its nominal radial plane has no analytic section in it
+    /// (ScanInPlane across it fails with surface not found), so the master blade, which is taught, keeps 0.
+    #[serde(default)]
+    pub index_deg: f64,
+}
+
+fn no_scale() -> [f64; 2] {
+    [1.0, 1.0]
 }
 
 /// Why a propeller configuration cannot be built.
@@ -69,6 +91,8 @@ pub enum PropellerError {
         "need 0 < hub_radius_mm <= root_radius_mm < tip_radius_mm, positive chords and hub height"
     )]
     BadDimensions,
+    #[error("blade {blade}: thickness_scale, chord_scale and camber_scale must be positive")]
+    BadScale { blade: usize },
 }
 
 /// One blade section at a radius: the airfoil placed in its (u, v) plane.
@@ -80,7 +104,14 @@ pub struct BladeSection {
 
 impl ClosedCurve for BladeSection {
     fn point(&self, s: f64) -> Point2<f64> {
-        let [x, y] = self.foil.point(s.rem_euclid(1.0));
+        self.placed(self.foil.point(s.rem_euclid(1.0)))
+    }
+}
+
+impl BladeSection {
+    /// A point of the airfoil in its own axes (leading edge at the origin) placed in the section plane: centred
+    /// at mid-chord, turned and shifted.
+    fn placed(&self, [x, y]: [f64; 2]) -> Point2<f64> {
         let x = x - self.foil.chord_mm / 2.0;
         let (sin, cos) = self.angle.sin_cos();
         Point2::new(x * cos - y * sin, x * sin + y * cos + self.shift)
@@ -92,34 +123,50 @@ pub struct Propeller {
     spec: PropellerSpec,
     foil: Naca4,
     pose: Isometry3<f64>,
-    /// The airfoil of unit chord, sampled once: every blade section is it scaled, turned and shifted, so a
-    /// nearest-point query needs no new samples (a scan asks thousands of them).
-    unit: SampledCurve<BladeSection>,
+    /// The stations of the coarse samples of the airfoil, computed once: a blade section's samples are placed
+    /// from them by its own thickness and camber, so a nearest-point query (a scan asks thousands of them)
+    /// evaluates no trigonometry for its samples.
+    stations: Vec<FoilStation>,
 }
 
-/// A blade section as a similarity of the unit-chord airfoil: exact, since a NACA section scales with its chord.
-struct ScaledSection<'a> {
-    unit: &'a SampledCurve<BladeSection>,
+/// A blade section as a similarity of its airfoil at unit chord: exact, since a NACA section scales with its chord.
+struct ScaledSection {
+    unit: SampledCurve<BladeSection>,
+    placement: Placement,
+}
+
+/// Where and how a blade's section lies at one radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Placement {
     chord: f64,
+    /// The thickness and maximum camber as fractions of the chord.
+    thickness: f64,
+    max_camber: f64,
     angle: f64,
     shift: f64,
 }
 
-impl PlaneNearest for ScaledSection<'_> {
+impl PlaneNearest for ScaledSection {
     fn nearest(&self, query: &Point2<f64>) -> Nearest {
-        let (sin, cos) = self.angle.sin_cos();
-        let (u, v) = (query.x, query.y - self.shift);
-        let in_unit = Point2::new(u * cos + v * sin, -u * sin + v * cos) / self.chord;
+        let Placement {
+            chord,
+            angle,
+            shift,
+            ..
+        } = self.placement;
+        let (sin, cos) = angle.sin_cos();
+        let (u, v) = (query.x, query.y - shift);
+        let in_unit = Point2::new(u * cos + v * sin, -u * sin + v * cos) / chord;
         let unit = self.unit.nearest(&in_unit);
         let turn = |w: Vector2<f64>| Vector2::new(w.x * cos - w.y * sin, w.x * sin + w.y * cos);
-        let point = turn(unit.on_curve.point.coords * self.chord) + Vector2::new(0.0, self.shift);
+        let point = turn(unit.on_curve.point.coords * chord) + Vector2::new(0.0, shift);
         Nearest {
             on_curve: CurvePoint {
                 s: unit.on_curve.s,
                 point: Point2::from(point),
                 normal: turn(unit.on_curve.normal),
             },
-            signed_distance: unit.signed_distance * self.chord,
+            signed_distance: unit.signed_distance * chord,
         }
     }
 }
@@ -142,47 +189,92 @@ impl Propeller {
         if !sane {
             return Err(PropellerError::BadDimensions);
         }
+        // A scale is linear from root to tip: positive at both ends keeps it positive between.
+        let scales = |e: &BladeError| [e.thickness_scale, e.chord_scale, e.camber_scale];
+        if let Some(blade) = spec
+            .blade_errors
+            .iter()
+            .position(|e| scales(e).iter().flatten().any(|s| s.is_nan() || *s <= 0.0))
+        {
+            return Err(PropellerError::BadScale { blade });
+        }
         let pose = spec.pose.isometry();
-        let unit = SampledCurve::new(BladeSection {
-            foil,
-            angle: 0.0,
-            shift: 0.0,
-        });
+        let stations = (0..SAMPLES)
+            .map(|i| foil.station(sample_parameter(i)))
+            .collect();
         Ok(Propeller {
             spec,
             foil,
             pose,
-            unit,
+            stations,
         })
     }
 
     /// The blade's section at `radius` in its plane's (u, v) coordinates, with the blade's error.
     pub fn section_curve(&self, blade: usize, radius: f64) -> BladeSection {
-        let (chord, angle, shift) = self.section_placement(blade, radius);
+        let placement = self.section_placement(blade, radius);
         BladeSection {
-            foil: Naca4 {
-                chord_mm: chord,
-                ..self.foil
-            },
-            angle,
-            shift,
+            foil: self.foil_of(&placement, placement.chord),
+            angle: placement.angle,
+            shift: placement.shift,
         }
     }
 
-    /// Chord, turn and shift of the blade's section at `radius`.
-    fn section_placement(&self, blade: usize, radius: f64) -> (f64, f64, f64) {
+    /// The airfoil of a placed section, at `chord_mm`.
+    fn foil_of(&self, placement: &Placement, chord_mm: f64) -> Naca4 {
+        Naca4 {
+            chord_mm,
+            thickness: placement.thickness,
+            max_camber: placement.max_camber,
+            ..self.foil
+        }
+    }
+
+    /// Chord, shape, turn and shift of the blade's section at `radius`.
+    fn section_placement(&self, blade: usize, radius: f64) -> Placement {
         let error = &self.spec.blade_errors[blade];
         let along = self.along(radius);
-        let angle = (self.spec.pitch_mm / (TAU * radius)).atan()
+        let pitch = self.spec.pitch_mm * (1.0 + along(error.pitch_error_pct) / 100.0);
+        let angle = (pitch / (TAU * radius)).atan()
             + along(self.spec.twist_deg).to_radians()
             + along(error.twist_deg).to_radians();
-        (along(self.spec.chord_mm), angle, along(error.shift_mm))
+        // Stretched along the chord by its scale, the section keeps its thickness and camber in mm: as fractions
+        // of the chord they shrink by the same scale.
+        let chord_scale = along(error.chord_scale);
+        Placement {
+            chord: along(self.spec.chord_mm) * chord_scale,
+            thickness: self.foil.thickness * along(error.thickness_scale) / chord_scale,
+            max_camber: self.foil.max_camber * along(error.camber_scale) / chord_scale,
+            angle,
+            shift: along(error.shift_mm),
+        }
+    }
+
+    /// The section at `radius` for nearest-point queries: its airfoil at unit chord with its samples placed
+    /// from the stored stations.
+    fn scaled_section(&self, blade: usize, radius: f64) -> ScaledSection {
+        let placement = self.section_placement(blade, radius);
+        let section = BladeSection {
+            foil: self.foil_of(&placement, 1.0),
+            angle: 0.0,
+            shift: 0.0,
+        };
+        let samples = self
+            .stations
+            .iter()
+            .map(|station| section.placed(section.foil.place(station)))
+            .collect();
+        ScaledSection {
+            unit: SampledCurve::with_samples(section, samples),
+            placement,
+        }
     }
 
     /// The plane frame of the blade's section at `radius`, in machine coordinates: origin on the blade
     /// axis at that radius, u tangential, v up the hub axis, w along the blade's radius.
     pub fn section_frame(&self, blade: usize, radius: f64) -> Frame {
-        let angle = TAU * blade as f64 / self.spec.blades as f64;
+        let angle = TAU * blade as f64 / self.spec.blades as f64
+            + self.spec.blade_errors[blade].index_deg.to_radians();
         let (sin, cos) = angle.sin_cos();
         let radial = Vector3::new(cos, sin, 0.0);
         let tangential = Vector3::new(-sin, cos, 0.0);
@@ -206,14 +298,7 @@ impl Propeller {
         let axis = self.section_frame(blade, 0.0);
         let range = (self.spec.root_radius_mm, self.spec.tip_radius_mm);
         let radius = axis.local(p).z.clamp(range.0, range.1);
-        let (chord, angle, shift) = self.section_placement(blade, radius);
-        let section = ScaledSection {
-            unit: &self.unit,
-            chord,
-            angle,
-            shift,
-        };
-        prism_nearest(&axis, range, &section, p)
+        prism_nearest(&axis, range, &self.scaled_section(blade, radius), p)
     }
 
     /// A lower bound of the distance from `p` to the blade: the distance to a box about the blade that
@@ -307,6 +392,11 @@ mod tests {
         let exact = BladeError {
             shift_mm: [0.0, 0.0],
             twist_deg: [0.0, 0.0],
+            thickness_scale: [1.0, 1.0],
+            chord_scale: [1.0, 1.0],
+            camber_scale: [1.0, 1.0],
+            pitch_error_pct: [0.0, 0.0],
+            index_deg: 0.0,
         };
         PropellerSpec {
             blades: 3,
@@ -355,6 +445,67 @@ mod tests {
         }
     }
 
+    /// A section's chord, its thickness and camber at station s (chord fraction (1 + cos 2 pi s) / 2, s in
+    /// (0, 0.5)) and its chord's angle (rad), read from its points: at one station the upper and lower points lie
+    /// on the mean line's normal, the thickness apart, with the mean line's point between them.
+    fn measured(section: &BladeSection, s: f64) -> (f64, f64, f64, f64) {
+        let (te, le) = (section.point(0.0), section.point(0.5));
+        let chord = (te - le).norm();
+        let (upper, lower) = (section.point(s), section.point(1.0 - s));
+        let along = (te - le) / chord;
+        let camber = ((upper + lower.coords) / 2.0 - le).perp(&along).abs();
+        let angle = along.y.atan2(along.x);
+        (chord, (upper - lower).norm(), camber, angle)
+    }
+
+    #[test]
+    fn each_blade_error_changes_its_own_parameter_only() {
+        let mut errors = spec();
+        let exact = errors.blade_errors[0];
+        // Halfway from root to tip (r = 310) each takes its mean of root and tip.
+        errors.blade_errors[1] = BladeError {
+            thickness_scale: [1.01, 1.03],
+            chord_scale: [0.99, 0.97],
+            ..exact
+        };
+        errors.blade_errors[2] = BladeError {
+            camber_scale: [1.1, 1.3],
+            pitch_error_pct: [1.0, 3.0],
+            index_deg: 0.25,
+            ..exact
+        };
+        let propeller = Propeller::new(errors).unwrap();
+        let r = 310.0;
+        let (a, b, c) = (
+            measured(&propeller.section_curve(0, r), 0.3),
+            measured(&propeller.section_curve(1, r), 0.3),
+            measured(&propeller.section_curve(2, r), 0.3),
+        );
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-9 * (1.0 + y.abs());
+        // B: 2 % thicker and 2 % shorter; the same camber in mm (chord positions keep their fraction, so the
+        // thickness compares at the same station).
+        assert!(close(b.0, a.0 * 0.98), "chord {b:?} {a:?}");
+        assert!(close(b.1, a.1 * 1.02), "thickness {b:?} {a:?}");
+        assert!(close(b.2, a.2), "camber {b:?} {a:?}");
+        assert!(close(b.3, a.3), "angle {b:?} {a:?}");
+        // C: 20 % more camber, the blade angle of a pitch 2 % coarse, the chord and thickness kept.
+        assert!(close(c.0, a.0) && close(c.1, a.1), "{c:?} {a:?}");
+        assert!(close(c.2, a.2 * 1.2), "camber {c:?} {a:?}");
+        assert!(close(c.3, (900.0 * 1.02 / (TAU * r)).atan()), "angle {c:?}");
+        // C turned 0.25 deg more about the hub axis than its place (240 deg).
+        let frame = propeller.section_frame(2, r);
+        let expected = (240.25f64).to_radians();
+        assert!(
+            (frame.origin - Point3::new(r * expected.cos(), r * expected.sin(), 0.0)).norm() < 1e-9
+        );
+        let mut bad = spec();
+        bad.blade_errors[2].chord_scale = [1.0, 0.0];
+        assert_eq!(
+            Propeller::new(bad).err(),
+            Some(PropellerError::BadScale { blade: 2 })
+        );
+    }
+
     #[test]
     fn sections_of_blade_a_lie_in_planes_of_constant_x() {
         let propeller = Propeller::new(spec()).unwrap();
@@ -393,16 +544,15 @@ mod tests {
 
     #[test]
     fn the_scaled_unit_section_is_the_sampled_section() {
-        let propeller = Propeller::new(spec()).unwrap();
+        // Blade B's shape is off too: its samples are placed from the stations of the nominal airfoil.
+        let mut errors = spec();
+        errors.blade_errors[1].thickness_scale = [1.05, 0.9];
+        errors.blade_errors[1].chord_scale = [1.1, 0.95];
+        errors.blade_errors[1].camber_scale = [0.8, 1.2];
+        let propeller = Propeller::new(errors).unwrap();
         for (blade, radius) in [(0, 100.0), (1, 333.3), (2, 560.0)] {
             let sampled = SampledCurve::new(propeller.section_curve(blade, radius));
-            let (chord, angle, shift) = propeller.section_placement(blade, radius);
-            let scaled = ScaledSection {
-                unit: &propeller.unit,
-                chord,
-                angle,
-                shift,
-            };
+            let scaled = propeller.scaled_section(blade, radius);
             for query in [[3.0, 40.0], [-70.0, -5.0], [0.5, 0.2], [55.0, -60.0]] {
                 let query = Point2::from(query);
                 let a = SampledCurve::nearest(&sampled, &query);
