@@ -91,6 +91,8 @@ fn report() -> PartReport {
                 name: name.to_string(),
                 stats: summary,
                 verdict: TOLERANCE.verdict(&summary, outside),
+                index_deg: None,
+                angular_spacing_deg: None,
                 profiles,
             }
         })

@@ -77,11 +77,25 @@ impl Plan {
     /// axis through its origin (the profile planes x = r are then the blade's sections at radius r, y their
     /// tangential direction: what a propeller's pitch is measured in); `None` for any other axis.
     pub fn profile_radius(&self, profile: usize) -> Option<f64> {
+        self.hub_sense().map(|_| self.profile_x(profile))
+    }
+
+    /// For a part turned about the z axis through the origin (a propeller's hub axis): +1 if its instances step
+    /// counter-clockwise seen from +z (axis +z, step > 0, or both reversed), -1 if clockwise; `None` for other
+    /// parts. A blade turned in its step's sense shifts its sections of x = r along +y times this.
+    pub fn hub_sense(&self) -> Option<f64> {
         let instances = &self.part.instances;
         let axis = Vector3::from(instances.axis_direction).try_normalize(0.0)?;
-        let about_z = (axis - Vector3::z()).norm() < 1e-12 || (axis + Vector3::z()).norm() < 1e-12;
         let through_origin = instances.axis_point_mm[0] == 0.0 && instances.axis_point_mm[1] == 0.0;
-        (about_z && through_origin).then(|| self.profile_x(profile))
+        let along_z = [1.0, -1.0]
+            .into_iter()
+            .find(|sign| (axis - Vector3::z() * *sign).norm() < 1e-12)?;
+        through_origin.then_some(along_z * instances.step_deg.signum())
+    }
+
+    /// The turn from one instance to the next about the axis, deg.
+    pub fn instance_step_deg(&self) -> f64 {
+        self.part.instances.step_deg
     }
 
     /// The part's name.

@@ -187,7 +187,7 @@ pub struct ParameterValue {
 }
 
 impl ParameterValue {
-    fn of(nominal: f64, measured: f64) -> Self {
+    pub(crate) fn of(nominal: f64, measured: f64) -> Self {
         ParameterValue {
             nominal,
             measured,
@@ -210,6 +210,11 @@ pub struct SectionParametersReport {
     pub max_camber_mm: ParameterValue,
     pub max_camber_at: ParameterValue,
     pub chord_angle_deg: ParameterValue,
+    /// The middle of the mean line's chord (the section's pitch reference point) in the profile plane's axes (y,
+    /// z of the part frame), mm: where the section lies, whatever its thickness, camber, chord length or twist
+    /// (each leaves the ends of a NACA mean line symmetric about it). Absent in older reports.
+    #[serde(default)]
+    pub chord_middle_mm: Option<[ParameterValue; 2]>,
     /// The local pitch 2 pi r tan(chord angle), mm: for a propeller's sections (planes at radius r about the hub
     /// axis z); absent for other parts.
     pub pitch_mm: Option<ParameterValue>,
@@ -239,6 +244,85 @@ pub fn parameters(
         max_camber_mm: value(|p| p.mean_line.max_camber_mm),
         max_camber_at: value(|p| p.mean_line.max_camber_at),
         chord_angle_deg: value(|p| p.mean_line.chord_angle_deg),
+        chord_middle_mm: Some([
+            value(|p| (p.mean_line.leading_end.x + p.mean_line.trailing_end.x) / 2.0),
+            value(|p| (p.mean_line.leading_end.y + p.mean_line.trailing_end.y) / 2.0),
+        ]),
         pitch_mm: radius_mm.map(|r| ParameterValue::of(pitch(nominal, r), pitch(&measured, r))),
     })
+}
+
+/// How far a blade is turned about the hub axis from its place (deg, in the sense of the instances' step), from
+/// its sections' `(radius_mm, tangential_shift_mm)` (of each chord's middle): the least-squares turn `sum(r s) / sum(r^2)` (radians) of a
+/// shift that grows as r tan(turn), through the axis. `None` without a section.
+pub(crate) fn index_deg(sections: &[(f64, f64)]) -> Option<f64> {
+    let (rs, rr) = sections
+        .iter()
+        .fold((0.0, 0.0), |(rs, rr), (r, s)| (rs + r * s, rr + r * r));
+    (rr > 0.0).then(|| (rs / rr).atan().to_degrees())
+}
+
+/// The angular spacing of each blade from the one before it (deg, nominal `|step_deg|`), from each blade's turn
+/// off its place in the step's sense ([`index_deg`]); the first blade's is from the last, where the blades go once
+/// round the axis (`step_deg` times their number a full turn), and `None` otherwise or where either turn is
+/// unknown.
+pub(crate) fn angular_spacings(
+    index: &[Option<f64>],
+    step_deg: f64,
+) -> Vec<Option<ParameterValue>> {
+    let n = index.len();
+    let step_deg = step_deg.abs();
+    let full_turn = (n as f64 * step_deg - 360.0).abs() < 1e-9;
+    (0..n)
+        .map(|k| {
+            let before = match k {
+                0 if full_turn && n > 1 => n - 1,
+                0 => return None,
+                _ => k - 1,
+            };
+            let (this, previous) = (index[k]?, index[before]?);
+            Some(ParameterValue::of(step_deg, step_deg + this - previous))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_blade_turned_about_the_hub_shifts_its_sections_by_r_tan_turn() {
+        let turn = 0.05f64.to_radians();
+        let sections: Vec<(f64, f64)> = [100.0, 200.0, 300.0, 400.0, 500.0]
+            .into_iter()
+            .map(|r| (r, r * turn.tan()))
+            .collect();
+        let read = index_deg(&sections).unwrap();
+        assert!((read - 0.05).abs() < 1e-12, "{read}");
+        // A shift that does not grow with the radius (a blade moved, not turned) reads as the turn that fits it
+        // best through the axis, weighted to the tip.
+        let moved: Vec<(f64, f64)> = sections.iter().map(|(r, _)| (*r, 0.1)).collect();
+        let expected = (0.1 * 1500.0 / 550_000.0f64).atan().to_degrees();
+        assert!((index_deg(&moved).unwrap() - expected).abs() < 1e-12);
+        assert_eq!(index_deg(&[]), None);
+    }
+
+    #[test]
+    fn spacings_go_from_each_blade_to_the_next_and_round_from_the_last_to_the_first() {
+        let spacings = angular_spacings(&[Some(0.0), Some(-0.02), Some(0.05)], 120.0);
+        let measured: Vec<f64> = spacings.iter().map(|s| s.unwrap().measured).collect();
+        for (m, e) in measured.iter().zip([119.95, 119.98, 120.07]) {
+            assert!((m - e).abs() < 1e-9, "{measured:?}");
+        }
+        assert!(spacings.iter().all(|s| s.unwrap().nominal == 120.0));
+        assert!((spacings[2].unwrap().deviation - 0.07).abs() < 1e-9);
+        // Stepping clockwise reads the same magnitudes.
+        let clockwise = angular_spacings(&[Some(0.0), Some(0.01)], -180.0);
+        assert_eq!(clockwise[1].unwrap().nominal, 180.0);
+        assert!((clockwise[1].unwrap().measured - 180.01).abs() < 1e-9);
+        // Four nuts 90 deg apart on a tray that does not close: no spacing for the first; an unknown turn leaves
+        // both of its spacings out.
+        let open = angular_spacings(&[Some(0.0), None, Some(0.0)], 90.0);
+        assert_eq!(open, vec![None, None, None]);
+    }
 }

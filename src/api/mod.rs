@@ -194,7 +194,7 @@ pub enum Event {
         machine: String,
         scan: ScanRef,
         best_fits: Vec<SectionBestFit>,
-        parameters: Option<SectionParametersReport>,
+        parameters: Option<Box<SectionParametersReport>>,
         at_unix_ms: u64,
     },
     /// The job stopped on a fault and waits for `zeroset clear`.

@@ -153,7 +153,7 @@ impl Watch {
                 parameters,
                 ..
             } => {
-                if let Some(text) = section_line(best_fits, parameters.as_ref()) {
+                if let Some(text) = section_line(best_fits, parameters.as_deref()) {
                     self.line(format!("{} {}: {text}", scan.instance, scan.profile))?;
                 }
             }

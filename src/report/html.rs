@@ -45,6 +45,7 @@ fn report_html(report: &PartReport) -> Result<String, PlotError> {
     page.push_str(&profile_table(report));
     page.push_str(&best_fit_table(report));
     page.push_str(&parameters_table(report));
+    page.push_str(&spacings_table(report));
     page.push_str(&figures_html(report)?);
     page.push_str("</body>\n</html>\n");
     Ok(page)
@@ -200,6 +201,37 @@ fn parameters_table(report: &PartReport) -> String {
     }
     html.push_str("</table>\n");
     html
+}
+
+/// Each blade's turn about the hub axis off its place and its angular spacing from the blade before it; nothing for
+/// parts that have none.
+fn spacings_table(report: &PartReport) -> String {
+    let rows: Vec<String> = report
+        .instances
+        .iter()
+        .filter_map(|i| {
+            let spacing = i.angular_spacing_deg?;
+            let turned = i
+                .index_deg
+                .map_or_else(|| "-".into(), |t| format!("{t:+.4} deg"));
+            Some(cells_row([
+                escape(&i.name),
+                turned,
+                format!("{:.4} deg ({:+.4})", spacing.measured, spacing.deviation),
+                format!("{:.4} deg", spacing.nominal),
+            ]))
+        })
+        .collect();
+    if rows.is_empty() {
+        return String::new();
+    }
+    format!(
+        "<h2>Blade places</h2>\n<p>Each blade's turn about the hub axis off its place, from how far its sections' \
+         chord middles lie along the tangent (r tan(turn) at radius r), and its angular spacing from the blade \
+         before it (the first from the last).</p>\n<table>\n<tr><th>blade</th><th>turned</th><th>angular spacing \
+         (deviation)</th><th>nominal</th></tr>\n{}</table>\n",
+        rows.concat()
+    )
 }
 
 /// A table row of plain cells, already escaped or formatted.

@@ -18,7 +18,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::section::{SectionBestFit, SectionParametersReport};
+use crate::analysis::section::{ParameterValue, SectionBestFit, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
@@ -102,6 +102,13 @@ pub struct InstanceReport {
     pub name: String,
     pub stats: DeviationStats,
     pub verdict: Verdict,
+    /// For a propeller's blade: how far it is turned about the hub axis from its place, deg (in the sense of the
+    /// instances' step), from its sections' least-squares fits; absent for other parts and in older reports.
+    #[serde(default)]
+    pub index_deg: Option<f64>,
+    /// ... and its angular spacing from the blade before it (the first blade's from the last), deg.
+    #[serde(default)]
+    pub angular_spacing_deg: Option<ParameterValue>,
     pub profiles: Vec<ProfileReport>,
 }
 

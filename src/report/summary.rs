@@ -105,7 +105,43 @@ pub fn summary_text(report: &PartReport) -> String {
     }
     text.push_str(&table(&rows, &LEFT_ALIGNED));
     text.push_str(&sections_text(report));
+    text.push_str(&spacings_text(report));
     text
+}
+
+/// Each blade's turn about the hub axis off its place and its angular spacing from the blade before it (deg);
+/// empty for parts that have none.
+fn spacings_text(report: &PartReport) -> String {
+    let mut rows = vec![[
+        "blade",
+        "turned_deg",
+        "spacing_deg",
+        "nominal_deg",
+        "d_spacing_deg",
+    ]
+    .map(String::from)
+    .to_vec()];
+    for instance in &report.instances {
+        let Some(spacing) = instance.angular_spacing_deg else {
+            continue;
+        };
+        let turned = instance.index_deg.map(|t| format!("{t:+.4}"));
+        rows.push(vec![
+            instance.name.clone(),
+            turned.unwrap_or_default(),
+            format!("{:.4}", spacing.measured),
+            format!("{:.4}", spacing.nominal),
+            format!("{:+.4}", spacing.deviation),
+        ]);
+    }
+    if rows.len() == 1 {
+        return String::new();
+    }
+    format!(
+        "\nblades: turn about the hub axis off their places (from the sections' least-squares fits) and angular \
+         spacing from the blade before (the first from the last)\n{}",
+        table(&rows, &[0])
+    )
 }
 
 /// Where each section lies after its least-squares best fit (dn: along the thickness direction, + above; twist

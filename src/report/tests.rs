@@ -71,6 +71,8 @@ fn instance(name: &str, base: f64, excess: usize) -> InstanceReport {
         name: name.to_string(),
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
+        index_deg: None,
+        angular_spacing_deg: None,
         profiles,
     }
 }
@@ -279,6 +281,30 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
     );
 }
 
+#[test]
+fn the_summary_gives_each_blades_turn_and_spacing_where_the_report_has_them() {
+    let mut report = sample_report();
+    assert!(
+        !summary_text(&report).contains("blades:"),
+        "a part with no spacings"
+    );
+    report.instances[1].index_deg = Some(0.0512);
+    report.instances[1].angular_spacing_deg = Some(crate::analysis::section::ParameterValue::of(
+        120.0, 120.0487,
+    ));
+    let text = summary_text(&report);
+    let line = text
+        .lines()
+        .skip_while(|l| !l.starts_with("blades:"))
+        .find(|l| l.starts_with("blade-B"))
+        .unwrap_or_else(|| panic!("no spacing row of blade-B in\n{text}"));
+    let cells: Vec<&str> = line.split_whitespace().collect();
+    assert_eq!(
+        cells,
+        ["blade-B", "+0.0512", "120.0487", "120.0000", "+0.0487"]
+    );
+}
+
 /// A blade section's parameters as a report holds them: B r100 of the simulator's propeller, made thinner and
 /// turned (deviations -0.0382 mm of thickness, -0.0293 deg of chord angle, -1.2770 mm of pitch).
 pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParametersReport {
@@ -298,6 +324,7 @@ pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParameters
         max_camber_mm: value(6.9075, 6.9073),
         max_camber_at: value(0.4, 0.4),
         chord_angle_deg: value(55.0768, 55.0475),
+        chord_middle_mm: Some([value(0.0, 0.0021), value(0.0, -0.4003)]),
         pitch_mm: Some(value(899.897, 898.62)),
     }
 }

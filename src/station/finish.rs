@@ -284,8 +284,17 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             name: name.clone(),
             verdict: inputs.tolerance.verdict(&stats, outside),
             stats,
+            index_deg: blade_index_deg(plan, &profiles),
+            angular_spacing_deg: None,
             profiles,
         });
+    }
+    let index: Vec<Option<f64>> = instances.iter().map(|i| i.index_deg).collect();
+    for (instance, spacing) in instances
+        .iter_mut()
+        .zip(section::angular_spacings(&index, plan.instance_step_deg()))
+    {
+        instance.angular_spacing_deg = spacing;
     }
     let verdict = Verdict::combine(instances.iter().map(|i| &i.verdict));
     let settings = &inputs.reference.settings;
@@ -364,4 +373,20 @@ fn copy_scans(dir: &JobDir, folder: &Path) -> std::io::Result<()> {
         crate::fsutil::write_atomically(&target.join(file), &bytes)?;
     }
     Ok(())
+}
+
+/// A propeller blade's turn about the hub axis off its place, deg, from how far along y the middle of each
+/// section's chord lies from its nominal's (the section at radius r moves by r tan(turn)): the chord's middle,
+/// not a best fit's shift, since a best fit takes part of a camber or thickness error for a shift. `None` for
+/// other parts or a blade with no section parameters.
+fn blade_index_deg(plan: &Plan, profiles: &[ProfileReport]) -> Option<f64> {
+    let sense = plan.hub_sense()?;
+    let sections: Vec<(f64, f64)> = profiles
+        .iter()
+        .filter_map(|profile| {
+            let [y, _] = profile.parameters.as_ref()?.chord_middle_mm?;
+            Some((profile.x_mm, sense * y.deviation))
+        })
+        .collect();
+    section::index_deg(&sections)
 }

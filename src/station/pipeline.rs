@@ -255,7 +255,7 @@ impl Pipeline {
                 machine,
                 scan,
                 best_fits,
-                parameters,
+                parameters: parameters.map(Box::new),
                 at_unix_ms: clock::unix_ms(),
             });
         });

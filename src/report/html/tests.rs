@@ -91,6 +91,8 @@ fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceRepor
         name: name.to_string(),
         stats,
         verdict,
+        index_deg: None,
+        angular_spacing_deg: None,
         profiles,
     }
 }
@@ -311,5 +313,23 @@ fn the_blade_table_shows_each_sections_parameters_measured_and_off_nominal() {
         html.matches("<td>r100</td><td>172.8700").count(),
         1,
         "one row, B's"
+    );
+}
+
+#[test]
+fn the_blade_places_table_gives_each_blades_turn_and_spacing() {
+    let mut report = three_blades();
+    assert!(!report_html(&report).unwrap().contains("Blade places"));
+    report.instances[2].index_deg = Some(0.0101);
+    report.instances[2].angular_spacing_deg = Some(crate::analysis::section::ParameterValue::of(
+        120.0, 120.0099,
+    ));
+    let html = report_html(&report).unwrap();
+    let row = "<tr><td>C</td><td>+0.0101 deg</td><td>120.0099 deg (+0.0099)</td><td>120.0000 deg</td></tr>";
+    assert!(html.contains(row), "{row} not in the page");
+    assert_eq!(
+        html.matches("<tr><td>A</td><td>").count(),
+        0,
+        "only C has a spacing"
     );
 }

@@ -75,6 +75,8 @@ fn instance(name: &str, machine: &str, profiles: Vec<ProfileReport>) -> Instance
         name: name.to_string(),
         stats: summary,
         verdict: TOLERANCE.verdict(&summary, outside),
+        index_deg: None,
+        angular_spacing_deg: None,
         profiles,
     }
 }
