@@ -1,6 +1,7 @@
 //! End-to-end tests of the `zeroset` binary: one test binary, shared helpers, the real executables. The
 //! simulator runs as `zeroset sim` on pseudo-terminals and the station's I++ client talks to it through them.
 
+mod blade_errors;
 mod campaign;
 mod daemon;
 mod errors;

@@ -8,7 +8,7 @@ use std::time::Duration;
 use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::transport::open_pty;
 use zeroset_sim::config::{PartSpec, SimConfig};
-use zeroset_sim::part::propeller::Propeller;
+use zeroset_sim::part::propeller::{Propeller, PropellerSpec};
 use zeroset_sim::simulator::parse_announcement;
 
 use crate::support::{config, repo};
@@ -129,9 +129,15 @@ pub fn quick() -> ClientConfig {
 
 /// The simulator's own analytic propeller, for checking what the probe reported.
 pub fn propeller() -> Propeller {
-    let loaded = SimConfig::load(config("sims/propeller.toml").as_ref()).expect("the config loads");
+    Propeller::new(propeller_spec("propeller.toml")).expect("a valid propeller")
+}
+
+/// The propeller of config/sims/`sim_config` as configured, errors and all.
+pub fn propeller_spec(sim_config: &str) -> PropellerSpec {
+    let loaded =
+        SimConfig::load(config(&format!("sims/{sim_config}")).as_ref()).expect("the config loads");
     let PartSpec::Propeller(spec) = &loaded.parts["propeller"] else {
-        panic!("propeller.toml holds a propeller");
+        panic!("{sim_config} holds a propeller");
     };
-    Propeller::new(spec.clone()).expect("a valid propeller")
+    spec.clone()
 }

@@ -3,7 +3,6 @@
 //! emergency stop and a killed daemon, each resumed with no point lost or counted twice; two watchers.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::time::Duration;
 
 use nalgebra::{Point2, Point3, Rotation3, Vector3};
@@ -11,8 +10,11 @@ use zeroset::api::Event;
 use zeroset::report::PartReport;
 use zeroset_sim::part::curve::SampledCurve;
 
+use zeroset_sim::part::propeller::PropellerSpec;
+
+use crate::blade_errors::{assert_parameters_read_the_injected_errors, injected};
 use crate::daemon::{job_over, Station};
-use crate::sim::propeller;
+use crate::sim::{propeller, propeller_spec};
 
 /// The agreement the issue asks for between measured and injected errors, mm.
 const AGREEMENT_MM: f64 = 0.005;
@@ -148,18 +150,19 @@ pub fn assert_no_repeated_points(report: &PartReport) {
 }
 
 /// Blades B and C of config/sims/propeller.toml lie 0.4 mm below and above A at the root (60 mm), 1.0 mm at the
-/// tip (560 mm), along the hub axis (z), untwisted: each section's best fit must read that shift in (y, z), no
-/// twist, and a form of the noise once it is removed; blade A reads zero.
-fn assert_best_fits_recover_the_blade_shifts(report: &zeroset::report::PartReport, html: &str) {
-    for instance in &report.instances {
+/// tip (560 mm), along the hub axis (z); B's pitch is coarse, which turns each section, and C is turned about the
+/// hub axis, which moves each section along y: each section's best fit must read that shift in (y, z), that
+/// twist, and a form of the noise once they are removed; blade A reads zero.
+fn assert_best_fits_recover_the_blade_errors(
+    report: &zeroset::report::PartReport,
+    spec: &PropellerSpec,
+    html: &str,
+) {
+    for (blade, instance) in report.instances.iter().enumerate() {
         for profile in &instance.profiles {
             let what = format!("blade {} profile {}", instance.name, profile.name);
-            let along = (profile.x_mm - 60.0) / 500.0;
-            let shift = match instance.name.as_str() {
-                "A" => 0.0,
-                "B" => -(0.4 + 0.6 * along),
-                _ => 0.4 + 0.6 * along,
-            };
+            let made = injected(spec, blade, profile.x_mm);
+            let [sy, sz] = made.shift_mm;
             let methods: Vec<&str> = profile
                 .best_fits
                 .iter()
@@ -168,13 +171,13 @@ fn assert_best_fits_recover_the_blade_shifts(report: &zeroset::report::PartRepor
             assert_eq!(methods, ["l2", "minzone"], "{what}");
             for fit in &profile.best_fits {
                 println!(
-                    "{what} {}: shift ({:+.4}, {:+.4}) mm (truth (0, {shift:+.4})), twist {:+.4} deg, form RMS {:.4} mm, zone {:.4} mm",
-                    fit.method, fit.shift_mm[0], fit.shift_mm[1], fit.rotation_deg, fit.form.rms_mm, fit.form.zone_mm
+                    "{what} {}: shift ({:+.4}, {:+.4}) mm (truth ({sy:+.4}, {sz:+.4})), twist {:+.4} deg (truth {:+.4}), form RMS {:.4} mm, zone {:.4} mm",
+                    fit.method, fit.shift_mm[0], fit.shift_mm[1], fit.rotation_deg, made.turn_deg, fit.form.rms_mm, fit.form.zone_mm
                 );
-                // The truth in the fit's own directions: the hub axis's components along the thickness and the
+                // The truth in the fit's own directions: along the thickness (the chord turned +90 deg) and the
                 // chord.
                 let [cy, cz] = fit.chord_direction;
-                let (truth_dn, truth_chord) = (shift * cy, shift * cz);
+                let (truth_dn, truth_chord) = (-sy * cz + sz * cy, sy * cy + sz * cz);
                 println!(
                     "  dn {:+.4} (truth {truth_dn:+.4}), dchord {:+.4} (truth {truth_chord:+.4})",
                     fit.dn_mm, fit.dchord_mm
@@ -190,8 +193,9 @@ fn assert_best_fits_recover_the_blade_shifts(report: &zeroset::report::PartRepor
                 assert!(
                     (fit.dn_mm - truth_dn).abs() < across_mm
                         && (fit.dchord_mm - truth_chord).abs() < chord_mm
-                        && fit.rotation_deg.abs() < twist_deg,
-                    "{what}: {fit:?}, truth dn {truth_dn}, dchord {truth_chord}"
+                        && (fit.rotation_deg - made.turn_deg).abs() < twist_deg,
+                    "{what}: {fit:?}, truth dn {truth_dn}, dchord {truth_chord}, twist {}",
+                    made.turn_deg
                 );
             }
             assert!(
@@ -207,64 +211,17 @@ fn assert_best_fits_recover_the_blade_shifts(report: &zeroset::report::PartRepor
     );
 }
 
-/// The blades of config/sims/propeller.toml are blade A moved along the hub axis: every section's parameters read
-/// as its nominal's within the noise, and the nominal's local pitch is the simulator's 900 mm (NACA 4412 sections
-/// turned by atan(pitch / (2 pi r))).
-fn assert_parameters_read_the_blades_alike(
-    report: &zeroset::report::PartReport,
-    daemon_log: &Path,
-) {
-    let why_none = || {
-        let log = std::fs::read_to_string(daemon_log).unwrap_or_default();
-        log.lines()
-            .filter(|l| l.contains("no parameters"))
-            .collect::<Vec<_>>()
-            .join("\n")
-    };
-    for instance in &report.instances {
-        for profile in &instance.profiles {
-            let what = format!("blade {} profile {}", instance.name, profile.name);
-            let p = profile
-                .parameters
-                .as_ref()
-                .unwrap_or_else(|| panic!("{what} has no parameters: {}", why_none()));
-            let pitch = p
-                .pitch_mm
-                .unwrap_or_else(|| panic!("{what}: a propeller's section has a pitch"));
-            println!(
-                "{what}: chord {:?}, thickness {:?}, camber {:?}, angle {:?}, pitch {pitch:?}, le {:?}, te {:?}",
-                p.chord_mm, p.max_thickness_mm, p.max_camber_mm, p.chord_angle_deg, p.le_thickness_mm, p.te_thickness_mm
-            );
-            assert!(
-                (pitch.nominal - 900.0).abs() < 0.002 * 900.0,
-                "{what}: nominal pitch {pitch:?}"
-            );
-            // Measured on one run: thickness within 4.2 um, camber 4.4 um, chord angle 2.7 millidegrees, pitch
-            // 0.012 %, trailing-edge thickness 8.5 um. The chord (31 um) and the leading-edge thickness (20 um) hang
-            // on the round nose, which the scan samples every 10 deg of its turn and the degree-8 model follows
-            // within tens of microns: they are held to that, until the reference models hold at the edges.
-            let within = [
-                ("max thickness", p.max_thickness_mm.deviation, 0.006),
-                ("max camber", p.max_camber_mm.deviation, 0.006),
-                ("chord angle (deg)", p.chord_angle_deg.deviation, 0.004),
-                (
-                    "pitch (% of nominal)",
-                    100.0 * pitch.deviation / pitch.nominal,
-                    0.03,
-                ),
-                (
-                    "trailing-edge thickness",
-                    p.te_thickness_mm.deviation,
-                    0.015,
-                ),
-                ("chord", p.chord_mm.deviation, 0.05),
-                ("leading-edge thickness", p.le_thickness_mm.deviation, 0.03),
-            ];
-            for (name, deviation, limit) in within {
-                assert!(deviation.abs() < limit, "{what}: {name} off by {deviation}");
-            }
-        }
-    }
+/// Blades of the wrong thickness, chord and camber (config/sims/propeller-shape-errors.toml), in their places:
+/// each section's parameters read the simulator's scales back, and the spacings read 120 deg.
+#[test]
+fn inspect_reads_back_blades_of_the_wrong_thickness_chord_and_camber() {
+    let station = Station::start("propeller-shape-errors.toml");
+    teach(&station);
+    let out = station.inspected(&["inspect", "propeller", "--serial", "SN-2"]);
+    assert!(out.contains("report: "), "{out}");
+    let (_, report) = station.report("SN-2");
+    let spec = propeller_spec("propeller-shape-errors.toml");
+    assert_parameters_read_the_injected_errors(&report, &spec, &station.daemon_log());
 }
 
 #[test]
@@ -361,8 +318,9 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         }
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
-    assert_best_fits_recover_the_blade_shifts(&report, &html);
-    assert_parameters_read_the_blades_alike(&report, &station.daemon_log());
+    let spec = propeller_spec("propeller.toml");
+    assert_best_fits_recover_the_blade_errors(&report, &spec, &html);
+    assert_parameters_read_the_injected_errors(&report, &spec, &station.daemon_log());
     assert!(report.instances[0].verdict.passed(), "blade A passes");
     assert!(!report.instances[1].verdict.passed(), "blade B fails");
     let summary = station.cli_ok(&["report", "SN-1"]);

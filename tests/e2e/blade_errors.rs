@@ -1,0 +1,170 @@
+//! What the simulator's blade errors (`blade_errors` in config/sims/*.toml) make of each blade section: the shift,
+//! turn and parameter changes the station must read back, worked out from the configuration alone.
+
+use std::f64::consts::TAU;
+use std::path::Path;
+
+use zeroset::report::PartReport;
+use zeroset_sim::part::propeller::PropellerSpec;
+
+/// A blade's section at one radius as the simulator makes it, against its nominal.
+pub struct Injected {
+    /// Where the section lies off its place in the master's section plane (y, z), mm: the blade's turn about the
+    /// hub axis moves it by r tan(turn) along y, its shift along the hub axis along z.
+    pub shift_mm: [f64; 2],
+    /// The section's turn in its plane, deg (counter-clockwise in (y, z)).
+    pub turn_deg: f64,
+    /// Its local pitch, nominal and made, mm.
+    pub pitch_mm: (f64, f64),
+    pub chord_scale: f64,
+    pub thickness_scale: f64,
+    pub camber_scale: f64,
+}
+
+/// What blade `blade` of `spec` is at radius `r` (mm).
+pub fn injected(spec: &PropellerSpec, blade: usize, r: f64) -> Injected {
+    let along = (r - spec.root_radius_mm) / (spec.tip_radius_mm - spec.root_radius_mm);
+    let at = |[root, tip]: [f64; 2]| root + (tip - root) * along;
+    let error = &spec.blade_errors[blade];
+    let design_twist = at(spec.twist_deg).to_radians();
+    let nominal_angle = (spec.pitch_mm / (TAU * r)).atan() + design_twist;
+    let pitch = spec.pitch_mm * (1.0 + at(error.pitch_error_pct) / 100.0);
+    let angle = (pitch / (TAU * r)).atan() + design_twist + at(error.twist_deg).to_radians();
+    let local_pitch = |angle: f64| TAU * r * angle.tan();
+    Injected {
+        shift_mm: [r * error.index_deg.to_radians().tan(), at(error.shift_mm)],
+        turn_deg: (angle - nominal_angle).to_degrees(),
+        pitch_mm: (local_pitch(nominal_angle), local_pitch(angle)),
+        chord_scale: at(error.chord_scale),
+        thickness_scale: at(error.thickness_scale),
+        camber_scale: at(error.camber_scale),
+    }
+}
+
+/// Every section's parameters read as the simulator made them, beside the master's nominal (what blade A is):
+/// the chord, thickness and camber scaled, the chord angle and the local pitch turned, and each blade's angular
+/// spacing from the one before it as their turns about the hub axis make it. The nominal local pitch is the
+/// simulator's (NACA 4412 sections turned by atan(pitch / (2 pi r))).
+pub fn assert_parameters_read_the_injected_errors(
+    report: &PartReport,
+    spec: &PropellerSpec,
+    daemon_log: &Path,
+) {
+    let why_none = || {
+        let log = std::fs::read_to_string(daemon_log).unwrap_or_default();
+        log.lines()
+            .filter(|l| l.contains("no parameters"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let mut problems = Vec::new();
+    for (blade, instance) in report.instances.iter().enumerate() {
+        for profile in &instance.profiles {
+            let what = format!("blade {} profile {}", instance.name, profile.name);
+            let p = profile
+                .parameters
+                .as_ref()
+                .unwrap_or_else(|| panic!("{what} has no parameters: {}", why_none()));
+            let pitch = p
+                .pitch_mm
+                .unwrap_or_else(|| panic!("{what}: a propeller's section has a pitch"));
+            let made = injected(spec, blade, profile.x_mm);
+            assert!(
+                (pitch.nominal - made.pitch_mm.0).abs() < 0.002 * made.pitch_mm.0,
+                "{what}: nominal pitch {pitch:?}, the simulator's {:.3} mm",
+                made.pitch_mm.0
+            );
+            println!(
+                "{what}: chord {:?}, thickness {:?}, camber {:?}, angle {:?}, pitch {pitch:?}, le {:?}, te {:?}",
+                p.chord_mm, p.max_thickness_mm, p.max_camber_mm, p.chord_angle_deg, p.le_thickness_mm, p.te_thickness_mm
+            );
+            // The edge thicknesses are taken a fixed distance in from each edge: on a chord of another length that
+            // is another station, so they are compared only where the chord is kept.
+            let chord_kept = (made.chord_scale - 1.0).abs() < 1e-12;
+            let edge = |nominal: f64| chord_kept.then_some(nominal * (made.thickness_scale - 1.0));
+            // Measured on one run of blades alike: thickness within 4.2 um, camber 4.4 um, chord angle 2.7
+            // millidegrees, pitch 0.012 %, trailing-edge thickness 8.5 um. The chord (31 um) and the leading-edge
+            // thickness (20 um) hang on the round nose, which the scan samples every 10 deg of its turn and the
+            // degree-8 model follows within tens of microns: they are held to that, until the reference models
+            // hold at the edges.
+            let checks = [
+                (
+                    "max thickness",
+                    p.max_thickness_mm.deviation,
+                    Some(p.max_thickness_mm.nominal * (made.thickness_scale - 1.0)),
+                    0.006,
+                ),
+                (
+                    "max camber",
+                    p.max_camber_mm.deviation,
+                    Some(p.max_camber_mm.nominal * (made.camber_scale - 1.0)),
+                    0.006,
+                ),
+                (
+                    "chord angle (deg)",
+                    p.chord_angle_deg.deviation,
+                    Some(made.turn_deg),
+                    0.004,
+                ),
+                (
+                    "pitch (% of nominal)",
+                    100.0 * pitch.deviation / pitch.nominal,
+                    Some(100.0 * (made.pitch_mm.1 / made.pitch_mm.0 - 1.0)),
+                    0.03,
+                ),
+                (
+                    "trailing-edge thickness",
+                    p.te_thickness_mm.deviation,
+                    edge(p.te_thickness_mm.nominal),
+                    0.015,
+                ),
+                (
+                    "chord",
+                    p.chord_mm.deviation,
+                    Some(p.chord_mm.nominal * (made.chord_scale - 1.0)),
+                    0.05,
+                ),
+                (
+                    "leading-edge thickness",
+                    p.le_thickness_mm.deviation,
+                    edge(p.le_thickness_mm.nominal),
+                    0.03,
+                ),
+            ];
+            for (name, deviation, expected, limit) in checks {
+                let Some(expected) = expected else { continue };
+                println!("  {name}: {deviation:+.5}, made {expected:+.5}");
+                if (deviation - expected).abs() >= limit {
+                    problems.push(format!(
+                        "{what}: {name} off by {deviation:+.5}, the simulator made {expected:+.5}"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert_spacings_read_the_blade_turns(report, spec);
+}
+
+/// Each blade's angular spacing from the one before it (the first's from the last) is 120 deg plus the
+/// difference of their turns about the hub axis, within 3 millidegrees.
+fn assert_spacings_read_the_blade_turns(report: &PartReport, spec: &PropellerSpec) {
+    let n = report.instances.len();
+    for (k, instance) in report.instances.iter().enumerate() {
+        let spacing = instance
+            .angular_spacing_deg
+            .unwrap_or_else(|| panic!("blade {} has no angular spacing", instance.name));
+        let before = (k + n - 1) % n;
+        let expected = 120.0 + spec.blade_errors[k].index_deg - spec.blade_errors[before].index_deg;
+        println!(
+            "blade {}: turned {:?} deg, spacing {spacing:?} (made {expected:.4})",
+            instance.name, instance.index_deg
+        );
+        assert_eq!(spacing.nominal, 120.0, "blade {}", instance.name);
+        assert!(
+            (spacing.measured - expected).abs() < 0.003,
+            "blade {}: spacing {spacing:?}, the simulator made {expected}",
+            instance.name
+        );
+    }
+}
