@@ -265,12 +265,7 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
     profile.best_fits = vec![fit("l2", -0.4012), fit("minzone", -0.3990)];
     profile.parameters = Some(sample_parameters());
     let text = summary_text(&report);
-    let line = text
-        .lines()
-        .skip_while(|l| !l.starts_with("sections:"))
-        .find(|l| l.starts_with("blade-B"))
-        .unwrap_or_else(|| panic!("no section row of blade-B in\n{text}"));
-    let cells: Vec<&str> = line.split_whitespace().collect();
+    let (line, cells) = summary_row(&text, "sections:", "blade-B");
     assert_eq!(
         cells,
         [
@@ -293,16 +288,21 @@ fn the_summary_gives_each_blades_turn_and_spacing_where_the_report_has_them() {
         120.0, 120.0487,
     ));
     let text = summary_text(&report);
-    let line = text
-        .lines()
-        .skip_while(|l| !l.starts_with("blades:"))
-        .find(|l| l.starts_with("blade-B"))
-        .unwrap_or_else(|| panic!("no spacing row of blade-B in\n{text}"));
-    let cells: Vec<&str> = line.split_whitespace().collect();
+    let (_, cells) = summary_row(&text, "blades:", "blade-B");
     assert_eq!(
         cells,
         ["blade-B", "+0.0512", "120.0487", "120.0000", "+0.0487"]
     );
+}
+
+/// The first row starting with `first` of the summary's table headed `table`, and its cells.
+fn summary_row<'a>(text: &'a str, table: &str, first: &str) -> (&'a str, Vec<&'a str>) {
+    let line = text
+        .lines()
+        .skip_while(|l| !l.starts_with(table))
+        .find(|l| l.starts_with(first))
+        .unwrap_or_else(|| panic!("no row of {first} under {table} in\n{text}"));
+    (line, line.split_whitespace().collect())
 }
 
 /// A blade section's parameters as a report holds them: B r100 of the simulator's propeller, made thinner and
