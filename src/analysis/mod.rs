@@ -12,6 +12,7 @@ pub mod part_mesh;
 pub mod reference;
 pub mod section;
 pub mod stats;
+pub mod tolerances;
 #[cfg(test)]
 pub(crate) mod test_profiles;
 

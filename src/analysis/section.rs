@@ -7,6 +7,7 @@ use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::deviation::ProfileGauge;
+use super::tolerances::{AppliedTolerance, Parameter, ParameterVerdict};
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::project_to_zero_set;
 use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured};
@@ -184,15 +185,34 @@ pub struct ParameterValue {
     pub measured: f64,
     /// Measured minus nominal.
     pub deviation: f64,
+    /// The limits the deviation is held to, where the part gives the parameter a tolerance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<AppliedTolerance>,
+    /// Whether the deviation is within them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<ParameterVerdict>,
 }
 
 impl ParameterValue {
+    /// Not yet judged against a tolerance.
     pub(crate) fn of(nominal: f64, measured: f64) -> Self {
         ParameterValue {
             nominal,
             measured,
             deviation: measured - nominal,
+            tolerance: None,
+            verdict: None,
         }
+    }
+
+    /// The mean of each of `values`' nominal and measured; `None` without one.
+    pub(crate) fn mean<'a>(values: impl IntoIterator<Item = &'a ParameterValue>) -> Option<Self> {
+        let (n, nominal, measured) = values
+            .into_iter()
+            .fold((0usize, 0.0, 0.0), |(n, nominal, measured), v| {
+                (n + 1, nominal + v.nominal, measured + v.measured)
+            });
+        (n > 0).then(|| ParameterValue::of(nominal / n as f64, measured / n as f64))
     }
 }
 
@@ -218,6 +238,38 @@ pub struct SectionParametersReport {
     /// The local pitch 2 pi r tan(chord angle), mm: for a propeller's sections (planes at radius r about the hub
     /// axis z); absent for other parts.
     pub pitch_mm: Option<ParameterValue>,
+    /// Pass if every parameter with a tolerance is within it; absent where none has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<ParameterVerdict>,
+}
+
+impl SectionParametersReport {
+    /// The parameters a tolerance can be given on.
+    pub(crate) fn judged(&self) -> impl Iterator<Item = &ParameterValue> {
+        [
+            &self.chord_mm,
+            &self.max_thickness_mm,
+            &self.le_thickness_mm,
+            &self.te_thickness_mm,
+            &self.max_camber_mm,
+            &self.chord_angle_deg,
+        ]
+        .into_iter()
+        .chain(self.pitch_mm.as_ref())
+    }
+
+    pub(crate) fn judged_mut(&mut self) -> impl Iterator<Item = (Parameter, &mut ParameterValue)> {
+        [
+            (Parameter::Chord, &mut self.chord_mm),
+            (Parameter::MaxThickness, &mut self.max_thickness_mm),
+            (Parameter::LeThickness, &mut self.le_thickness_mm),
+            (Parameter::TeThickness, &mut self.te_thickness_mm),
+            (Parameter::MaxCamber, &mut self.max_camber_mm),
+            (Parameter::ChordAngle, &mut self.chord_angle_deg),
+        ]
+        .into_iter()
+        .chain(self.pitch_mm.as_mut().map(|p| (Parameter::Pitch, p)))
+    }
 }
 
 /// The parameters of the section scanned as `points` (part frame, in scan order round it, flagged contacts left
@@ -249,6 +301,7 @@ pub fn parameters(
             value(|p| (p.mean_line.leading_end.y + p.mean_line.trailing_end.y) / 2.0),
         ]),
         pitch_mm: radius_mm.map(|r| ParameterValue::of(pitch(nominal, r), pitch(&measured, r))),
+        verdict: None,
     })
 }
 

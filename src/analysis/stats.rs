@@ -127,6 +127,7 @@ impl Tolerance {
             Verdict::Fail {
                 points_outside,
                 worst_mm: stats.worst_mm,
+                parameters_outside: 0,
             }
         }
     }

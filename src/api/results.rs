@@ -18,20 +18,37 @@ pub struct DeviationStats {
     pub worst_at_mm: [f64; 3],
 }
 
-/// Whether a profile, instance or part is within tolerance.
+/// Whether a profile, instance or part is within tolerance: every point within the part's band, and every
+/// toleranced parameter (of its sections, blades, the part) within its limits.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "verdict", rename_all = "snake_case")]
 pub enum Verdict {
     Pass,
     Fail {
         points_outside: usize,
+        /// The largest |deviation| of a point, whether or not a point is outside.
         worst_mm: f64,
+        /// Parameters out of their tolerance (absent in older reports, and when none is).
+        #[serde(default, skip_serializing_if = "is_zero")]
+        parameters_outside: usize,
     },
+}
+
+/// "1 point", "2 points".
+fn counted(n: usize, what: &str) -> String {
+    match n {
+        1 => format!("1 {what}"),
+        n => format!("{n} {what}s"),
+    }
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl Verdict {
     /// The verdict of a whole made of parts (an instance of its profiles, a part of its instances): it passes iff
-    /// every part passes; a failure counts every point outside and keeps the largest |worst|.
+    /// every part passes; a failure counts every point and parameter outside and keeps the largest |worst|.
     pub fn combine<'a>(verdicts: impl IntoIterator<Item = &'a Verdict>) -> Verdict {
         verdicts
             .into_iter()
@@ -42,10 +59,12 @@ impl Verdict {
                     Verdict::Fail {
                         points_outside,
                         worst_mm,
+                        parameters_outside,
                     },
                     Verdict::Fail {
                         points_outside: more,
                         worst_mm: other,
+                        parameters_outside: more_parameters,
                     },
                 ) => Verdict::Fail {
                     points_outside: points_outside + more,
@@ -54,8 +73,61 @@ impl Verdict {
                     } else {
                         worst_mm
                     },
+                    parameters_outside: parameters_outside + more_parameters,
                 },
             })
+    }
+
+    /// This verdict with `parameters` more parameters out of tolerance, of a whole whose largest |deviation| is
+    /// `worst_mm`.
+    pub fn with_parameters_outside(self, parameters: usize, worst_mm: f64) -> Verdict {
+        if parameters == 0 {
+            return self;
+        }
+        let failed = Verdict::Fail {
+            points_outside: 0,
+            worst_mm,
+            parameters_outside: parameters,
+        };
+        Verdict::combine([&self, &failed])
+    }
+
+    /// What failed, e.g. "2 points outside the tolerance, 1 parameter out of tolerance"; `None` for a pass.
+    pub fn what_failed(&self) -> Option<String> {
+        let Verdict::Fail {
+            points_outside,
+            parameters_outside,
+            ..
+        } = self
+        else {
+            return None;
+        };
+        let points = format!("{} outside the tolerance", counted(*points_outside, "point"));
+        Some(match parameters_outside {
+            0 => points,
+            n => format!("{points}, {} out of tolerance", counted(*n, "parameter")),
+        })
+    }
+
+    /// The verdict in a table's cell, beside a column of the worst deviation: "PASS", "FAIL (2 outside)",
+    /// "FAIL (0 outside, 1 parameter)".
+    pub fn cell_text(&self) -> String {
+        match self {
+            Verdict::Pass => "PASS".to_string(),
+            Verdict::Fail {
+                points_outside,
+                parameters_outside: 0,
+                ..
+            } => format!("FAIL ({points_outside} outside)"),
+            Verdict::Fail {
+                points_outside,
+                parameters_outside,
+                ..
+            } => format!(
+                "FAIL ({points_outside} outside, {})",
+                counted(*parameters_outside, "parameter")
+            ),
+        }
     }
 
     pub fn passed(&self) -> bool {

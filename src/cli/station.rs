@@ -192,12 +192,9 @@ pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<Option<Verdict
 /// An inspection's verdict as the command's outcome: a failing part is [`JobEnded::PartFailed`] (exit code 4).
 pub fn judge(part: &str, serial: &str, verdict: Option<Verdict>) -> anyhow::Result<()> {
     match verdict {
-        Some(Verdict::Fail {
-            points_outside,
-            worst_mm,
-        }) => Err(JobEnded::PartFailed(format!(
-            "part {part} serial {serial}: FAIL, {points_outside} {} outside the tolerance, worst {worst_mm:+.3} mm",
-            if points_outside == 1 { "point" } else { "points" }
+        Some(failed @ Verdict::Fail { worst_mm, .. }) => Err(JobEnded::PartFailed(format!(
+            "part {part} serial {serial}: FAIL, {}, worst {worst_mm:+.3} mm",
+            failed.what_failed().unwrap_or_default()
         ))
         .into()),
         Some(Verdict::Pass) => outln!("part {part} serial {serial}: PASS"),

@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{finite, in_reach, parse_toml, read_text, ConfigError, MAX_COORDINATE_MM};
+use crate::analysis::tolerances::{Iso484Class, ParameterRules, ParameterTolerances};
 pub use crate::analysis::ReferenceSettings;
 use crate::geometry::poly::MAX_DEGREE;
 
@@ -81,12 +82,23 @@ pub struct ScanSettings {
     pub max_angle_deg: f64,
 }
 
-/// The band a deviation must lie in for the instance to pass.
+/// The band a deviation must lie in for the instance to pass, and the tolerances on its sections' and blades'
+/// parameters: a ship propeller's ISO 484 class (config/iso484.toml), and per parameter, overriding the class.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToleranceEntry {
     pub lower_mm: f64,
     pub upper_mm: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class: Option<Iso484Class>,
+    #[serde(default)]
+    pub parameters: ParameterRules,
+}
+
+impl ToleranceEntry {
+    pub fn parameter_tolerances(&self) -> ParameterTolerances {
+        ParameterTolerances::new(self.class, self.parameters)
+    }
 }
 
 impl PartConfig {
@@ -169,6 +181,10 @@ impl PartConfig {
                 tolerance.lower_mm, tolerance.upper_mm
             ));
         }
+        tolerance
+            .parameters
+            .check()
+            .map_err(|problem| format!("[tolerance.parameters] {problem}"))?;
         Ok(())
     }
 }

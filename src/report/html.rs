@@ -285,7 +285,7 @@ fn stats_row(
         html,
         "<td class=\"name {}\">{}</td></tr>",
         verdict_class(verdict),
-        verdict_cell(verdict)
+        verdict.cell_text()
     )
     .expect("writing to a String");
     html
@@ -338,21 +338,11 @@ fn tolerance_text(tolerance: &Tolerance) -> String {
 fn verdict_text(verdict: &Verdict) -> String {
     match verdict {
         Verdict::Pass => "PASS".to_string(),
-        Verdict::Fail {
-            points_outside,
-            worst_mm,
-        } => format!(
-            "FAIL: {points_outside} points outside the tolerance, worst {}",
+        Verdict::Fail { worst_mm, .. } => format!(
+            "FAIL: {}, worst {}",
+            verdict.what_failed().unwrap_or_default(),
             deviation_mm(*worst_mm)
         ),
-    }
-}
-
-/// The table's verdict: the worst deviation has its own column.
-fn verdict_cell(verdict: &Verdict) -> String {
-    match verdict {
-        Verdict::Pass => "PASS".to_string(),
-        Verdict::Fail { points_outside, .. } => format!("FAIL ({points_outside} outside)"),
     }
 }
 

@@ -211,11 +211,8 @@ fn row(
         deviation(stats.max_mm),
         deviation(stats.worst_mm),
         format!("({})", at.join(", ")),
-        match verdict {
-            Verdict::Pass => "PASS".to_string(),
-            // The worst deviation has its own column.
-            Verdict::Fail { points_outside, .. } => format!("FAIL ({points_outside} outside)"),
-        },
+        // The worst deviation has its own column.
+        verdict.cell_text(),
     ]
 }
 
@@ -235,11 +232,9 @@ pub(super) fn deviation(mm: f64) -> String {
 fn verdict_text(verdict: &Verdict) -> String {
     match verdict {
         Verdict::Pass => "PASS".to_string(),
-        Verdict::Fail {
-            points_outside,
-            worst_mm,
-        } => format!(
-            "FAIL ({points_outside} points outside the tolerance, worst {} mm)",
+        Verdict::Fail { worst_mm, .. } => format!(
+            "FAIL ({}, worst {} mm)",
+            verdict.what_failed().unwrap_or_default(),
             deviation(*worst_mm)
         ),
     }

@@ -124,7 +124,8 @@ fn a_written_report_reads_back_as_it_was_and_leaves_only_its_three_files() {
         report.verdict,
         Verdict::Fail {
             points_outside: 2,
-            worst_mm: 0.12
+            worst_mm: 0.12,
+            parameters_outside: 0,
         }
     );
     let root = tempfile::tempdir().unwrap();
@@ -309,11 +310,7 @@ fn summary_row<'a>(text: &'a str, table: &str, first: &str) -> (&'a str, Vec<&'a
 /// turned (deviations -0.0382 mm of thickness, -0.0293 deg of chord angle, -1.2770 mm of pitch).
 pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParametersReport {
     use crate::analysis::section::ParameterValue;
-    let value = |nominal: f64, measured: f64| ParameterValue {
-        nominal,
-        measured,
-        deviation: measured - nominal,
-    };
+    let value = ParameterValue::of;
     crate::analysis::section::SectionParametersReport {
         edge_distance_mm: 2.0,
         chord_mm: value(172.85, 172.87),
@@ -326,5 +323,6 @@ pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParameters
         chord_angle_deg: value(55.0768, 55.0475),
         chord_middle_mm: Some([value(0.0, 0.0021), value(0.0, -0.4003)]),
         pitch_mm: Some(value(899.897, 898.62)),
+        verdict: None,
     }
 }

@@ -132,7 +132,8 @@ fn a_verdict_passes_inside_and_fails_with_the_count_outside() {
         failed,
         Verdict::Fail {
             points_outside: 2,
-            worst_mm: 0.15
+            worst_mm: 0.15,
+            parameters_outside: 0,
         }
     );
     let json = serde_json::to_string(&failed).unwrap();
@@ -143,14 +144,56 @@ fn a_verdict_passes_inside_and_fails_with_the_count_outside() {
     let other = Verdict::Fail {
         points_outside: 1,
         worst_mm: -0.4,
+        parameters_outside: 0,
     };
     assert_eq!(
         Verdict::combine([&inside, &failed, &Verdict::Pass, &other]),
         Verdict::Fail {
             points_outside: 3,
-            worst_mm: -0.4
+            worst_mm: -0.4,
+            parameters_outside: 0,
         }
     );
     assert!(Verdict::combine([&inside, &Verdict::Pass]).passed());
     assert!(Verdict::combine([]).passed());
+}
+
+#[test]
+fn parameters_out_of_tolerance_fail_a_verdict_and_are_counted_apart_from_points() {
+    let failed = Verdict::Pass.with_parameters_outside(2, -0.03);
+    assert_eq!(
+        failed,
+        Verdict::Fail {
+            points_outside: 0,
+            worst_mm: -0.03,
+            parameters_outside: 2,
+        }
+    );
+    assert_eq!(
+        failed.what_failed().unwrap(),
+        "0 points outside the tolerance, 2 parameters out of tolerance"
+    );
+    assert_eq!(failed.cell_text(), "FAIL (0 outside, 2 parameters)");
+    let points = Verdict::Fail {
+        points_outside: 1,
+        worst_mm: 0.2,
+        parameters_outside: 0,
+    };
+    // Older reports have no count of parameters; a verdict without one writes none.
+    let json = serde_json::to_string(&points).unwrap();
+    assert!(!json.contains("parameters_outside"), "{json}");
+    assert_eq!(serde_json::from_str::<Verdict>(&json).unwrap(), points);
+    assert_eq!(points.what_failed().unwrap(), "1 point outside the tolerance");
+    let both = points.clone().with_parameters_outside(1, 0.2);
+    assert_eq!(
+        both,
+        Verdict::Fail {
+            points_outside: 1,
+            worst_mm: 0.2,
+            parameters_outside: 1,
+        }
+    );
+    assert_eq!(Verdict::combine([&both, &failed]).cell_text(), "FAIL (1 outside, 3 parameters)");
+    assert_eq!(points.clone().with_parameters_outside(0, 0.2), points);
+    assert_eq!(Verdict::Pass.with_parameters_outside(0, 0.0), Verdict::Pass);
 }

@@ -139,6 +139,7 @@ fn propeller(instances: Vec<InstanceReport>) -> PartReport {
             Verdict::Fail {
                 points_outside: failing,
                 worst_mm: worst,
+                parameters_outside: 0,
             }
         },
         instances,
