@@ -93,6 +93,7 @@ fn report() -> PartReport {
                 verdict: TOLERANCE.verdict(&summary, outside),
                 index_deg: None,
                 angular_spacing_deg: None,
+                blade_pitch_mm: None,
                 profiles,
             }
         })
@@ -120,6 +121,8 @@ fn report() -> PartReport {
         compensation: "ball radius along the normal".into(),
         tolerance: TOLERANCE,
         rescans: Vec::new(),
+        iso484: None,
+        propeller_pitch_mm: None,
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }

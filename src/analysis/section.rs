@@ -245,17 +245,25 @@ pub struct SectionParametersReport {
 
 impl SectionParametersReport {
     /// The parameters a tolerance can be given on.
-    pub(crate) fn judged(&self) -> impl Iterator<Item = &ParameterValue> {
+    pub(crate) fn judged(&self) -> impl Iterator<Item = (Parameter, &ParameterValue)> {
         [
-            &self.chord_mm,
-            &self.max_thickness_mm,
-            &self.le_thickness_mm,
-            &self.te_thickness_mm,
-            &self.max_camber_mm,
-            &self.chord_angle_deg,
+            (Parameter::Chord, &self.chord_mm),
+            (Parameter::MaxThickness, &self.max_thickness_mm),
+            (Parameter::LeThickness, &self.le_thickness_mm),
+            (Parameter::TeThickness, &self.te_thickness_mm),
+            (Parameter::MaxCamber, &self.max_camber_mm),
+            (Parameter::ChordAngle, &self.chord_angle_deg),
         ]
         .into_iter()
-        .chain(self.pitch_mm.as_ref())
+        .chain(self.pitch_mm.as_ref().map(|p| (Parameter::Pitch, p)))
+    }
+
+    /// The values of those out of tolerance, each with its name (the report's key).
+    pub(crate) fn out_of_tolerance(&self) -> Vec<(&'static str, &ParameterValue)> {
+        self.judged()
+            .filter(|(_, v)| v.verdict == Some(ParameterVerdict::Fail))
+            .map(|(parameter, v)| (parameter.key(), v))
+            .collect()
     }
 
     pub(crate) fn judged_mut(&mut self) -> impl Iterator<Item = (Parameter, &mut ParameterValue)> {

@@ -105,6 +105,17 @@ pub(crate) enum Parameter {
     AngularSpacing,
 }
 
+impl Parameter {
+    /// Its name in reports and in `[tolerance.parameters]`.
+    pub(crate) fn key(self) -> &'static str {
+        ParameterRules::default()
+            .entries()
+            .into_iter()
+            .find(|(p, ..)| *p == self)
+            .map_or("", |(_, key, _)| key)
+    }
+}
+
 /// A tolerance per parameter, each optional; the keys are the report's parameter names.
 #[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(deny_unknown_fields)]
@@ -282,7 +293,7 @@ impl ParameterTolerances {
         for (parameter, value) in section.judged_mut() {
             self.judge(parameter, value);
         }
-        section.verdict = verdict_of(section.judged());
+        section.verdict = verdict_of(section.judged().map(|(_, v)| v));
     }
 }
 

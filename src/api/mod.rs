@@ -16,6 +16,7 @@ mod results;
 mod states;
 
 pub use results::{DeviationStats, Verdict};
+pub(crate) use results::counted;
 pub use states::{FaultKind, JobPhase, MachineFault, MachineState};
 
 /// The version of these types; bumped on any change a reader of the old version would misread.

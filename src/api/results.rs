@@ -35,11 +35,8 @@ pub enum Verdict {
 }
 
 /// "1 point", "2 points".
-fn counted(n: usize, what: &str) -> String {
-    match n {
-        1 => format!("1 {what}"),
-        n => format!("{n} {what}s"),
-    }
+pub(crate) fn counted(count: usize, noun: &str) -> String {
+    format!("{count} {noun}{}", if count == 1 { "" } else { "s" })
 }
 
 fn is_zero(n: &usize) -> bool {

@@ -7,7 +7,9 @@ use std::collections::HashMap;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::analysis::section::{SectionBestFit, SectionParametersReport};
+use crate::analysis::tolerances::ParameterVerdict;
 use crate::analysis::stats::{DeviationStats, RunningStats, Verdict};
+use crate::api::counted;
 use crate::api::{Event, InstanceSummary, JobInfo, JobKind, ScanRef};
 
 /// How a followed job ended, or stopped to wait for `zeroset clear`.
@@ -302,10 +304,6 @@ impl Watch {
 }
 
 /// "1 instance", "3 instances".
-fn counted(count: usize, noun: &str) -> String {
-    format!("{count} {noun}{}", if count == 1 { "" } else { "s" })
-}
-
 fn console_is_terminal() -> bool {
     use std::io::IsTerminal;
     std::io::stderr().is_terminal()
@@ -327,8 +325,11 @@ fn section_line(
             .pitch_mm
             .map(|v| format!(", pitch {:+.3} %", 100.0 * v.deviation / v.nominal))
             .unwrap_or_default();
+        let verdict = parameters_verdict_text(p)
+            .map(|text| format!(": {text}"))
+            .unwrap_or_default();
         format!(
-            "off nominal: max thickness {:+.4} mm, chord {:+.4} mm, camber {:+.4} mm, chord angle {:+.4} deg{pitch}",
+            "off nominal: max thickness {:+.4} mm, chord {:+.4} mm, camber {:+.4} mm, chord angle {:+.4} deg{pitch}{verdict}",
             p.max_thickness_mm.deviation,
             p.chord_mm.deviation,
             p.max_camber_mm.deviation,
@@ -344,6 +345,41 @@ fn section_line(
                 .join("; "),
         ),
     }
+}
+
+/// A section's verdict on its toleranced parameters and whose tolerances they were, each failure with its
+/// deviation and limits, e.g. "FAIL (ISO 484 class S): pitch_mm -21.3000 mm outside [-20.0000, +20.0000] mm";
+/// `None` where no parameter has a tolerance.
+fn parameters_verdict_text(parameters: &SectionParametersReport) -> Option<String> {
+    let verdict = parameters.verdict?;
+    let mut sources: Vec<String> = Vec::new();
+    for (_, value) in parameters.judged() {
+        if let Some(tolerance) = value.tolerance {
+            let source = tolerance.from.to_string();
+            if !sources.contains(&source) {
+                sources.push(source);
+            }
+        }
+    }
+    let sources = sources.join(" and ");
+    Some(match verdict {
+        ParameterVerdict::Pass => format!("PASS ({sources})"),
+        ParameterVerdict::Fail => {
+            let failures: Vec<String> = parameters
+                .out_of_tolerance()
+                .into_iter()
+                .filter_map(|(name, value)| {
+                    let tolerance = value.tolerance?;
+                    let unit = if name.ends_with("_deg") { "deg" } else { "mm" };
+                    Some(format!(
+                        "{name} {:+.4} {unit} outside [{:+.4}, {:+.4}] {unit}",
+                        value.deviation, tolerance.lower, tolerance.upper
+                    ))
+                })
+                .collect();
+            format!("FAIL ({sources}): {}", failures.join(", "))
+        }
+    })
 }
 
 fn event_job(event: &Event) -> Option<&str> {
@@ -488,5 +524,39 @@ mod tests {
         assert_eq!(watch.show(&other).unwrap(), None);
         assert_eq!(counted(1, "instance"), "1 instance");
         assert_eq!(counted(3, "profile"), "3 profiles");
+    }
+
+    #[test]
+    fn a_sections_line_gives_its_parameters_verdict_naming_each_failure_and_its_limits() {
+        use crate::analysis::tolerances::{
+            Iso484Class, ParameterRules, ParameterTolerances, ToleranceRule,
+        };
+        // B r100 of the sample: pitch 899.897 mm nominal, -1.277 mm off (-0.142 %), thickness -0.0382 mm.
+        let mut within = crate::report::tests::sample_parameters();
+        ParameterTolerances::new(Some(Iso484Class::S), ParameterRules::default())
+            .judge_section(&mut within);
+        let line = section_line(&[], Some(&within)).unwrap();
+        assert!(line.ends_with("pitch -0.142 %: PASS (ISO 484 class S)"), "{line}");
+        // The part file holds the thickness to 0.03 mm: it fails, and the line says by how much.
+        let thin = ParameterRules {
+            max_thickness_mm: Some(ToleranceRule {
+                lower: Some(-0.03),
+                upper: Some(0.03),
+                ..ToleranceRule::default()
+            }),
+            ..ParameterRules::default()
+        };
+        let mut failing = crate::report::tests::sample_parameters();
+        ParameterTolerances::new(Some(Iso484Class::S), thin).judge_section(&mut failing);
+        let line = section_line(&[], Some(&failing)).unwrap();
+        assert!(
+            line.ends_with(
+                ": FAIL (ISO 484 class S and the part file): max_thickness_mm -0.0382 mm outside [-0.0300, +0.0300] mm"
+            ),
+            "{line}"
+        );
+        // Nothing toleranced, no verdict.
+        let line = section_line(&[], Some(&crate::report::tests::sample_parameters())).unwrap();
+        assert!(line.ends_with("pitch -0.142 %"), "{line}");
     }
 }

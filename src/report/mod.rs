@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::section::{ParameterValue, SectionBestFit, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
+use crate::analysis::tolerances::Iso484Class;
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
 pub use qif::{write_qif, QIF_FILE};
@@ -53,12 +54,25 @@ pub struct PartReport {
     /// How ball centres became surface points, e.g. "ball radius along the reported normal".
     pub compensation: String,
     pub tolerance: Tolerance,
+    /// The ISO 484 class the parameters were judged by, where the part file names one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iso484: Option<ClassUse>,
     pub instances: Vec<InstanceReport>,
-    /// Pass iff every instance passes.
+    /// For a propeller: its mean pitch, the mean of its blades' mean pitches, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub propeller_pitch_mm: Option<ParameterValue>,
+    /// Pass iff every instance passes and the propeller's mean pitch is within its tolerance.
     pub verdict: Verdict,
     /// Profiles scanned again because a scan came back with a hole in it (absent from older reports).
     #[serde(default)]
     pub rescans: Vec<Rescan>,
+}
+
+/// An ISO 484 class and where its table comes from.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct ClassUse {
+    pub class: Iso484Class,
+    pub cites: String,
 }
 
 /// A profile scanned again, and why.
@@ -109,6 +123,9 @@ pub struct InstanceReport {
     /// ... and its angular spacing from the blade before it (the first blade's from the last), deg.
     #[serde(default)]
     pub angular_spacing_deg: Option<ParameterValue>,
+    /// For a propeller's blade: its mean pitch, the mean of its sections' pitches, mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blade_pitch_mm: Option<ParameterValue>,
     pub profiles: Vec<ProfileReport>,
 }
 
@@ -199,4 +216,4 @@ pub fn read_report(dir: &Path) -> Result<PartReport, ReportError> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -73,6 +73,7 @@ fn instance(name: &str, base: f64, excess: usize) -> InstanceReport {
         verdict: TOLERANCE.verdict(&summary, outside),
         index_deg: None,
         angular_spacing_deg: None,
+        blade_pitch_mm: None,
         profiles,
     }
 }
@@ -103,6 +104,8 @@ pub(super) fn sample_report() -> PartReport {
         compensation: "ball radius along the reported normal".to_string(),
         tolerance: TOLERANCE,
         rescans: Vec::new(),
+        iso484: None,
+        propeller_pitch_mm: None,
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }

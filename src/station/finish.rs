@@ -10,17 +10,19 @@ use nalgebra::Vector2;
 use super::job::job_scans;
 use super::journal::{file_stem, JobDir, JobRecord};
 use super::pipeline::scan_ref;
+use super::verdicts::judge_blades;
 use crate::analysis::compensate_scan;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::{teach, MasterProfile, Reference};
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
+use crate::analysis::tolerances::failures;
 use crate::analysis::{fit_sanity, section};
 use crate::api::{InstanceSummary, JobKind, ProfileFit};
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
 use crate::plan::Plan;
 use crate::report::{
-    write_html, write_qif, write_report, InstanceReport, MachineUse, PartReport, PointRecord,
+    write_html, write_qif, write_report, ClassUse, InstanceReport, MachineUse, PartReport, PointRecord,
     ProfileReport, ReferenceUse, Store,
 };
 
@@ -177,6 +179,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
     let serial = inputs.record.serial.clone().unwrap_or_default();
     let mut machines: BTreeMap<String, MachineUse> = BTreeMap::new();
     let mut instances: Vec<InstanceReport> = Vec::new();
+    let tolerances = plan.tolerance().parameter_tolerances();
     for (instance, name) in plan.instance_names().iter().enumerate() {
         let mut profiles = Vec::new();
         let mut all = RunningStats::default();
@@ -259,10 +262,15 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                 .nominal_parameters()
                 .map_err(str::to_string)
                 .and_then(|nominal| section::parameters(nominal, &in_part, plan.profile_radius(key.profile)))
+                .map(|mut parameters| {
+                    tolerances.judge_section(&mut parameters);
+                    parameters
+                })
                 .map_err(|problem| {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no parameters of the section");
                 })
                 .ok();
+            let section_failures = parameters.as_ref().map_or(0, |p| failures(p.judged().map(|(_, v)| v)));
             all.merge(&stats);
             outside += profile_outside;
             profiles.push(ProfileReport {
@@ -271,7 +279,10 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                 machine: scan.header.machine.clone(),
                 scanned_at: scan.finished.clone(),
                 stats: summary,
-                verdict: inputs.tolerance.verdict(&summary, profile_outside),
+                verdict: inputs
+                    .tolerance
+                    .verdict(&summary, profile_outside)
+                    .with_parameters_outside(section_failures, summary.worst_mm),
                 best_fits,
                 parameters,
                 points,
@@ -286,6 +297,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             stats,
             index_deg: blade_index_deg(plan, &profiles),
             angular_spacing_deg: None,
+            blade_pitch_mm: None,
             profiles,
         });
     }
@@ -296,7 +308,13 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
     {
         instance.angular_spacing_deg = spacing;
     }
-    let verdict = Verdict::combine(instances.iter().map(|i| &i.verdict));
+    let propeller_pitch_mm = judge_blades(&tolerances, &mut instances);
+    let worst_mm = instances
+        .iter()
+        .map(|i| i.stats.worst_mm)
+        .fold(0.0, |worst: f64, w| if w.abs() > worst.abs() { w } else { worst });
+    let verdict = Verdict::combine(instances.iter().map(|i| &i.verdict))
+        .with_parameters_outside(failures(propeller_pitch_mm.iter()), worst_mm);
     let settings = &inputs.reference.settings;
     let report = PartReport {
         format: crate::report::FORMAT.to_string(),
@@ -326,7 +344,12 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                        surface is more concave than the ball flagged and left out of the statistics"
             .into(),
         tolerance: inputs.tolerance,
+        iso484: tolerances.class().map(|(class, cites)| ClassUse {
+            class,
+            cites: cites.to_string(),
+        }),
         instances,
+        propeller_pitch_mm,
         verdict: verdict.clone(),
         rescans: inputs.record.rescans.clone(),
     };

@@ -17,6 +17,7 @@ mod journal;
 mod motion;
 mod pipeline;
 mod recorder;
+mod verdicts;
 mod worker;
 
 use tokio::sync::{broadcast, mpsc, oneshot};

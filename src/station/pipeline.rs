@@ -235,6 +235,7 @@ impl Pipeline {
             self.scan_ref(key),
         );
         let radius = self.plan.profile_radius(key.profile);
+        let tolerances = self.plan.tolerance().parameter_tolerances();
         let described = self.plan.describe(key);
         tokio::task::spawn_blocking(move || {
             let gauge = &gauges[key.profile];
@@ -246,6 +247,10 @@ impl Pipeline {
                 .nominal_parameters()
                 .map_err(str::to_string)
                 .and_then(|nominal| section::parameters(nominal, &in_part, radius))
+                .map(|mut parameters| {
+                    tolerances.judge_section(&mut parameters);
+                    parameters
+                })
                 .map_err(|problem| {
                     tracing::warn!(scan = %described, %problem, "live: no parameters of the section");
                 })

@@ -93,6 +93,7 @@ fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceRepor
         verdict,
         index_deg: None,
         angular_spacing_deg: None,
+        blade_pitch_mm: None,
         profiles,
     }
 }
@@ -133,6 +134,8 @@ fn propeller(instances: Vec<InstanceReport>) -> PartReport {
         compensation: "ball radius along the normal".to_string(),
         tolerance: TOLERANCE,
         rescans: Vec::new(),
+        iso484: None,
+        propeller_pitch_mm: None,
         verdict: if failing == 0 {
             Verdict::Pass
         } else {

@@ -77,6 +77,7 @@ fn instance(name: &str, machine: &str, profiles: Vec<ProfileReport>) -> Instance
         verdict: TOLERANCE.verdict(&summary, outside),
         index_deg: None,
         angular_spacing_deg: None,
+        blade_pitch_mm: None,
         profiles,
     }
 }
@@ -147,6 +148,8 @@ fn two_blade_report() -> PartReport {
         compensation: "ball radius along the reported normal".to_string(),
         tolerance: TOLERANCE,
         rescans: Vec::new(),
+        iso484: None,
+        propeller_pitch_mm: None,
         verdict: Verdict::combine(instances.iter().map(|i| &i.verdict)),
         instances,
     }
