@@ -297,6 +297,17 @@ impl ParameterTolerances {
     }
 }
 
+/// A parameter out of its tolerance in words, e.g. "max_thickness_mm -0.0382 mm outside [-0.0300, +0.0300] mm";
+/// `None` if it is not out of one. `name` is the report's key, whose ending gives the unit.
+pub(crate) fn failure_text(name: &str, value: &ParameterValue) -> Option<String> {
+    let tolerance = value.tolerance.filter(|_| value.verdict == Some(ParameterVerdict::Fail))?;
+    let unit = if name.ends_with("_deg") { "deg" } else { "mm" };
+    Some(format!(
+        "{name} {:+.4} {unit} outside [{:+.4}, {:+.4}] {unit}",
+        value.deviation, tolerance.lower, tolerance.upper
+    ))
+}
+
 /// The verdict on several parameters: none toleranced, `None`; else a failure if any fails.
 pub(crate) fn verdict_of<'a>(
     values: impl IntoIterator<Item = &'a ParameterValue>,

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::analysis::section::{SectionBestFit, SectionParametersReport};
-use crate::analysis::tolerances::ParameterVerdict;
+use crate::analysis::tolerances::{failure_text, ParameterVerdict};
 use crate::analysis::stats::{DeviationStats, RunningStats, Verdict};
 use crate::api::counted;
 use crate::api::{Event, InstanceSummary, JobInfo, JobKind, ScanRef};
@@ -368,14 +368,7 @@ fn parameters_verdict_text(parameters: &SectionParametersReport) -> Option<Strin
             let failures: Vec<String> = parameters
                 .out_of_tolerance()
                 .into_iter()
-                .filter_map(|(name, value)| {
-                    let tolerance = value.tolerance?;
-                    let unit = if name.ends_with("_deg") { "deg" } else { "mm" };
-                    Some(format!(
-                        "{name} {:+.4} {unit} outside [{:+.4}, {:+.4}] {unit}",
-                        value.deviation, tolerance.lower, tolerance.upper
-                    ))
-                })
+                .filter_map(|(name, value)| failure_text(name, value))
                 .collect();
             format!("FAIL ({sources}): {}", failures.join(", "))
         }

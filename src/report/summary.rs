@@ -5,7 +5,8 @@
 use std::fmt::Write;
 
 use super::PartReport;
-use crate::analysis::section::SectionParametersReport;
+use crate::analysis::section::{ParameterValue, SectionParametersReport};
+use crate::analysis::tolerances::{failure_text, ParameterVerdict, ToleranceSource};
 use crate::analysis::stats::{DeviationStats, Verdict};
 
 /// Deviations are shown to 0.1 um, coordinates to 1 um, in every report people read.
@@ -27,7 +28,7 @@ const COLUMNS: [&str; 11] = [
 ];
 /// The first columns are names, left-aligned; the rest numbers, right-aligned; the verdict is left-aligned.
 const LEFT_ALIGNED: [usize; 3] = [0, 1, 10];
-const SECTION_COLUMNS: [&str; 12] = [
+const SECTION_COLUMNS: [&str; 13] = [
     "instance",
     "profile",
     "dn_mm",
@@ -40,6 +41,7 @@ const SECTION_COLUMNS: [&str; 12] = [
     "d_te_mm",
     "d_chord_angle_deg",
     "d_pitch_%",
+    "parameters",
 ];
 
 /// The summary table as text (also printed by the CLI).
@@ -47,7 +49,7 @@ pub fn summary_text(report: &PartReport) -> String {
     let mut text = String::new();
     let machines: Vec<String> = report.machines.iter().map(machine_text).collect();
     let reference = &report.reference;
-    let lines = [
+    let mut lines = vec![
         (
             "part",
             format!(
@@ -75,6 +77,9 @@ pub fn summary_text(report: &PartReport) -> String {
             "all lengths in mm, deviations positive outside the material".into(),
         ),
     ];
+    if let Some(tolerances) = parameter_tolerances_text(report) {
+        lines.insert(5, ("parameter tolerances", tolerances));
+    }
     let label_width = lines
         .iter()
         .map(|(label, _)| label.len())
@@ -106,6 +111,7 @@ pub fn summary_text(report: &PartReport) -> String {
     text.push_str(&table(&rows, &LEFT_ALIGNED));
     text.push_str(&sections_text(report));
     text.push_str(&spacings_text(report));
+    text.push_str(&failures_text(report));
     text
 }
 
@@ -118,28 +124,44 @@ fn spacings_text(report: &PartReport) -> String {
         "spacing_deg",
         "nominal_deg",
         "d_spacing_deg",
+        "mean_pitch_mm",
+        "d_mean_pitch_%",
     ]
     .map(String::from)
     .to_vec()];
     for instance in &report.instances {
-        let Some(spacing) = instance.angular_spacing_deg else {
+        let (spacing, pitch) = (instance.angular_spacing_deg, instance.blade_pitch_mm);
+        if spacing.is_none() && pitch.is_none() {
             continue;
-        };
+        }
         let turned = instance.index_deg.map(|t| format!("{t:+.4}"));
         rows.push(vec![
             instance.name.clone(),
             turned.unwrap_or_default(),
-            format!("{:.4}", spacing.measured),
-            format!("{:.4}", spacing.nominal),
-            format!("{:+.4}", spacing.deviation),
+            spacing.map_or(String::new(), |s| format!("{:.4}", s.measured)),
+            spacing.map_or(String::new(), |s| format!("{:.4}", s.nominal)),
+            spacing.map_or(String::new(), |s| format!("{:+.4}", s.deviation)),
+            pitch.map_or(String::new(), |p| format!("{:.3}", p.measured)),
+            pitch.map_or(String::new(), |p| pitch_percent(&p)),
         ]);
     }
     if rows.len() == 1 {
         return String::new();
     }
+    let propeller = report
+        .propeller_pitch_mm
+        .map(|p| {
+            format!(
+                "propeller mean pitch {:.3} mm (nominal {:.3} mm, {} %)\n",
+                p.measured,
+                p.nominal,
+                pitch_percent(&p)
+            )
+        })
+        .unwrap_or_default();
     format!(
-        "\nblades: turn about the hub axis off their places (from the sections' least-squares fits) and angular \
-         spacing from the blade before (the first from the last)\n{}",
+        "\nblades: turn about the hub axis off their places (from the sections' chord middles), angular spacing \
+         from the blade before (the first from the last), and mean pitch (of the sections' pitches)\n{}{propeller}",
         table(&rows, &[0])
     )
 }
@@ -174,8 +196,9 @@ fn sections_text(report: &PartReport) -> String {
                 or_blank(
                     parameters
                         .and_then(|p| p.pitch_mm)
-                        .map(|v| format!("{:+.3}", 100.0 * v.deviation / v.nominal)),
+                        .map(|v| pitch_percent(&v)),
                 ),
+                or_blank(parameters.and_then(|p| p.verdict).map(|v| parameter_verdict_word(v).into())),
             ]);
         }
     }
@@ -186,8 +209,92 @@ fn sections_text(report: &PartReport) -> String {
         "\nsections: least-squares best fit (dn along the thickness, + above; dchord along the chord; twist \
          counter-clockwise in y, z) and parameters minus nominal (thickness: largest inscribed circle; le, te: edge \
          thicknesses; pitch in % of nominal)\n{}",
-        table(&rows, &[0, 1])
+        table(&rows, &[0, 1, 12])
     )
+}
+
+/// A pitch's deviation in percent of its nominal, e.g. "+0.213".
+fn pitch_percent(pitch: &ParameterValue) -> String {
+    format!("{:+.3}", 100.0 * pitch.deviation / pitch.nominal)
+}
+
+fn parameter_verdict_word(verdict: ParameterVerdict) -> &'static str {
+    match verdict {
+        ParameterVerdict::Pass => "PASS",
+        ParameterVerdict::Fail => "FAIL",
+    }
+}
+
+/// Where the parameters' tolerances come from, if any parameter has one.
+pub(super) fn parameter_tolerances_text(report: &PartReport) -> Option<String> {
+    let class = report
+        .iso484
+        .as_ref()
+        .map(|c| format!("ISO 484 class {} ({})", c.class, c.cites));
+    let from_part = every_judged(report).any(|(_, _, v)| {
+        v.tolerance.map(|t| t.from) == Some(ToleranceSource::PartFile)
+    });
+    let part = from_part.then(|| "the part file's [tolerance.parameters]".to_string());
+    match (class, part) {
+        (Some(class), Some(part)) => Some(format!("{part}, else {class}")),
+        (class, part) => class.or(part),
+    }
+}
+
+/// Every toleranced parameter of the report with where it is ("B r100", "blade B", "propeller") and its name.
+fn every_judged(report: &PartReport) -> impl Iterator<Item = (String, &'static str, &ParameterValue)> {
+    let sections = report.instances.iter().flat_map(|instance| {
+        instance.profiles.iter().flat_map(move |profile| {
+            profile.parameters.iter().flat_map(move |p| {
+                p.judged()
+                    .map(move |(parameter, v)| (format!("{} {}", instance.name, profile.name), parameter.key(), v))
+            })
+        })
+    });
+    let blades = report.instances.iter().flat_map(|instance| {
+        let blade = format!("blade {}", instance.name);
+        [
+            ("blade_pitch_mm", instance.blade_pitch_mm.as_ref()),
+            ("angular_spacing_deg", instance.angular_spacing_deg.as_ref()),
+        ]
+        .into_iter()
+        .filter_map(move |(name, v)| Some((blade.clone(), name, v?)))
+    });
+    let propeller = report
+        .propeller_pitch_mm
+        .as_ref()
+        .map(|v| ("propeller".to_string(), "propeller_pitch_mm", v));
+    sections
+        .chain(blades)
+        .chain(propeller)
+        .filter(|(_, _, v)| v.tolerance.is_some())
+}
+
+/// Each parameter out of tolerance, where it is, by how much and whose tolerance, e.g. "B r100: pitch_mm -21.3000
+/// mm outside [-20.0000, +20.0000] mm (ISO 484 class S)".
+pub(super) fn parameter_failures(report: &PartReport) -> Vec<String> {
+    every_judged(report)
+        .filter_map(|(place, name, value)| {
+            let text = failure_text(name, value)?;
+            let from = value.tolerance?.from;
+            Some(format!("{place}: {text} ({from})"))
+        })
+        .collect()
+}
+
+/// The list of parameters out of tolerance, if any.
+fn failures_text(report: &PartReport) -> String {
+    let failures = parameter_failures(report);
+    if failures.is_empty() {
+        return String::new();
+    }
+    let mut text = String::from("
+out of tolerance:
+");
+    for failure in failures {
+        writeln!(text, "  {failure}").expect("writing to a String");
+    }
+    text
 }
 
 fn row(

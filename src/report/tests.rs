@@ -329,3 +329,57 @@ pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParameters
         verdict: None,
     }
 }
+
+#[test]
+fn the_summary_names_whose_tolerances_judged_the_parameters_and_lists_each_one_out_of_them() {
+    use crate::analysis::tolerances::{
+        Iso484Class, ParameterRules, ParameterTolerances, ToleranceRule,
+    };
+    let mut report = sample_report();
+    assert!(!summary_text(&report).contains("parameter tolerances"));
+    let thin = ParameterRules {
+        max_thickness_mm: Some(ToleranceRule {
+            lower: Some(-0.03),
+            upper: Some(0.03),
+            ..ToleranceRule::default()
+        }),
+        ..ParameterRules::default()
+    };
+    let tolerances = ParameterTolerances::new(Some(Iso484Class::I), thin);
+    let mut parameters = sample_parameters();
+    tolerances.judge_section(&mut parameters);
+    report.instances[1].profiles[0].parameters = Some(parameters);
+    // Blade B's mean pitch 1.2 % coarse: outside class I's +-1 %.
+    let mut pitch = crate::analysis::section::ParameterValue::of(900.0, 910.8);
+    tolerances.judge(crate::analysis::tolerances::Parameter::BladePitch, &mut pitch);
+    report.instances[1].blade_pitch_mm = Some(pitch);
+    let (class, cites) = tolerances.class().unwrap();
+    report.iso484 = Some(super::ClassUse {
+        class,
+        cites: cites.into(),
+    });
+    let text = summary_text(&report);
+    assert!(
+        text.contains(
+            "parameter tolerances  the part file's [tolerance.parameters], else ISO 484 class I (ISO 484-2:1981"
+        ),
+        "{text}"
+    );
+    let (_, cells) = summary_row(&text, "sections:", "blade-B");
+    assert_eq!(cells.last(), Some(&"FAIL"), "{text}");
+    let (_, cells) = summary_row(&text, "blades:", "blade-B");
+    assert_eq!(cells, ["blade-B", "910.800", "+1.200"]);
+    let failures: Vec<&str> = text
+        .lines()
+        .skip_while(|l| *l != "out of tolerance:")
+        .skip(1)
+        .collect();
+    assert_eq!(
+        failures,
+        [
+            // The section's pitch, -0.142 %, is within class I's +-1.5 %.
+            "  blade-B p100: max_thickness_mm -0.0382 mm outside [-0.0300, +0.0300] mm (the part file)",
+            "  blade blade-B: blade_pitch_mm +10.8000 mm outside [-9.0000, +9.0000] mm (ISO 484 class I)",
+        ]
+    );
+}
