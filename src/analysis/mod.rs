@@ -12,9 +12,9 @@ pub mod part_mesh;
 pub mod reference;
 pub mod section;
 pub mod stats;
-pub mod tolerances;
 #[cfg(test)]
 pub(crate) mod test_profiles;
+pub mod tolerances;
 
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};

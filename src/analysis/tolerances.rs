@@ -78,7 +78,11 @@ impl ToleranceRule {
             }
             for value in [absolute, pct].into_iter().flatten() {
                 if !value.is_finite() || value * sign < 0.0 {
-                    let wanted = if sign < 0.0 { "at most 0" } else { "at least 0" };
+                    let wanted = if sign < 0.0 {
+                        "at most 0"
+                    } else {
+                        "at least 0"
+                    };
                     return Err(format!(
                         "{name}: {side} limit {value} must be a finite deviation {wanted}"
                     ));
@@ -150,15 +154,39 @@ impl ParameterRules {
     fn entries(&self) -> [(Parameter, &'static str, Option<ToleranceRule>); 10] {
         [
             (Parameter::Chord, "chord_mm", self.chord_mm),
-            (Parameter::MaxThickness, "max_thickness_mm", self.max_thickness_mm),
-            (Parameter::LeThickness, "le_thickness_mm", self.le_thickness_mm),
-            (Parameter::TeThickness, "te_thickness_mm", self.te_thickness_mm),
+            (
+                Parameter::MaxThickness,
+                "max_thickness_mm",
+                self.max_thickness_mm,
+            ),
+            (
+                Parameter::LeThickness,
+                "le_thickness_mm",
+                self.le_thickness_mm,
+            ),
+            (
+                Parameter::TeThickness,
+                "te_thickness_mm",
+                self.te_thickness_mm,
+            ),
             (Parameter::MaxCamber, "max_camber_mm", self.max_camber_mm),
-            (Parameter::ChordAngle, "chord_angle_deg", self.chord_angle_deg),
+            (
+                Parameter::ChordAngle,
+                "chord_angle_deg",
+                self.chord_angle_deg,
+            ),
             (Parameter::Pitch, "pitch_mm", self.pitch_mm),
             (Parameter::BladePitch, "blade_pitch_mm", self.blade_pitch_mm),
-            (Parameter::PropellerPitch, "propeller_pitch_mm", self.propeller_pitch_mm),
-            (Parameter::AngularSpacing, "angular_spacing_deg", self.angular_spacing_deg),
+            (
+                Parameter::PropellerPitch,
+                "propeller_pitch_mm",
+                self.propeller_pitch_mm,
+            ),
+            (
+                Parameter::AngularSpacing,
+                "angular_spacing_deg",
+                self.angular_spacing_deg,
+            ),
         ]
     }
 
@@ -261,7 +289,8 @@ impl ParameterTolerances {
 
     /// The class, with the citation of its table.
     pub fn class(&self) -> Option<(Iso484Class, &'static str)> {
-        self.class.map(|class| (class, class_table().cites.as_str()))
+        self.class
+            .map(|class| (class, class_table().cites.as_str()))
     }
 
     fn rule(&self, parameter: Parameter) -> Option<(ToleranceRule, ToleranceSource)> {
@@ -300,7 +329,9 @@ impl ParameterTolerances {
 /// A parameter out of its tolerance in words, e.g. "max_thickness_mm -0.0382 mm outside [-0.0300, +0.0300] mm";
 /// `None` if it is not out of one. `name` is the report's key, whose ending gives the unit.
 pub(crate) fn failure_text(name: &str, value: &ParameterValue) -> Option<String> {
-    let tolerance = value.tolerance.filter(|_| value.verdict == Some(ParameterVerdict::Fail))?;
+    let tolerance = value
+        .tolerance
+        .filter(|_| value.verdict == Some(ParameterVerdict::Fail))?;
     let unit = if name.ends_with("_deg") { "deg" } else { "mm" };
     Some(format!(
         "{name} {:+.4} {unit} outside [{:+.4}, {:+.4}] {unit}",

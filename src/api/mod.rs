@@ -15,8 +15,8 @@ pub mod fuzz;
 mod results;
 mod states;
 
-pub use results::{DeviationStats, Verdict};
 pub(crate) use results::counted;
+pub use results::{DeviationStats, Verdict};
 pub use states::{FaultKind, JobPhase, MachineFault, MachineState};
 
 /// The version of these types; bumped on any change a reader of the old version would misread.

@@ -99,7 +99,10 @@ impl Verdict {
         else {
             return None;
         };
-        let points = format!("{} outside the tolerance", counted(*points_outside, "point"));
+        let points = format!(
+            "{} outside the tolerance",
+            counted(*points_outside, "point")
+        );
         Some(match parameters_outside {
             0 => points,
             n => format!("{points}, {} out of tolerance", counted(*n, "parameter")),

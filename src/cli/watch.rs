@@ -7,8 +7,8 @@ use std::collections::HashMap;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::analysis::section::{SectionBestFit, SectionParametersReport};
-use crate::analysis::tolerances::{failure_text, ParameterVerdict};
 use crate::analysis::stats::{DeviationStats, RunningStats, Verdict};
+use crate::analysis::tolerances::{failure_text, ParameterVerdict};
 use crate::api::counted;
 use crate::api::{Event, InstanceSummary, JobInfo, JobKind, ScanRef};
 
@@ -529,7 +529,10 @@ mod tests {
         ParameterTolerances::new(Some(Iso484Class::S), ParameterRules::default())
             .judge_section(&mut within);
         let line = section_line(&[], Some(&within)).unwrap();
-        assert!(line.ends_with("pitch -0.142 %: PASS (ISO 484 class S)"), "{line}");
+        assert!(
+            line.ends_with("pitch -0.142 %: PASS (ISO 484 class S)"),
+            "{line}"
+        );
         // The part file holds the thickness to 0.03 mm: it fails, and the line says by how much.
         let thin = ParameterRules {
             max_thickness_mm: Some(ToleranceRule {

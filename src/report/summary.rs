@@ -6,8 +6,8 @@ use std::fmt::Write;
 
 use super::PartReport;
 use crate::analysis::section::{ParameterValue, SectionParametersReport};
-use crate::analysis::tolerances::{failure_text, ParameterVerdict, ToleranceSource};
 use crate::analysis::stats::{DeviationStats, Verdict};
+use crate::analysis::tolerances::{failure_text, ParameterVerdict, ToleranceSource};
 
 /// Deviations are shown to 0.1 um, coordinates to 1 um, in every report people read.
 pub(super) const DEVIATION_DECIMALS: usize = 4;
@@ -198,7 +198,11 @@ fn sections_text(report: &PartReport) -> String {
                         .and_then(|p| p.pitch_mm)
                         .map(|v| pitch_percent(&v)),
                 ),
-                or_blank(parameters.and_then(|p| p.verdict).map(|v| parameter_verdict_word(v).into())),
+                or_blank(
+                    parameters
+                        .and_then(|p| p.verdict)
+                        .map(|v| parameter_verdict_word(v).into()),
+                ),
             ]);
         }
     }
@@ -231,9 +235,8 @@ pub(super) fn parameter_tolerances_text(report: &PartReport) -> Option<String> {
         .iso484
         .as_ref()
         .map(|c| format!("ISO 484 class {} ({})", c.class, c.cites));
-    let from_part = every_judged(report).any(|(_, _, v)| {
-        v.tolerance.map(|t| t.from) == Some(ToleranceSource::PartFile)
-    });
+    let from_part = every_judged(report)
+        .any(|(_, _, v)| v.tolerance.map(|t| t.from) == Some(ToleranceSource::PartFile));
     let part = from_part.then(|| "the part file's [tolerance.parameters]".to_string());
     match (class, part) {
         (Some(class), Some(part)) => Some(format!("{part}, else {class}")),
@@ -242,12 +245,19 @@ pub(super) fn parameter_tolerances_text(report: &PartReport) -> Option<String> {
 }
 
 /// Every toleranced parameter of the report with where it is ("B r100", "blade B", "propeller") and its name.
-fn every_judged(report: &PartReport) -> impl Iterator<Item = (String, &'static str, &ParameterValue)> {
+fn every_judged(
+    report: &PartReport,
+) -> impl Iterator<Item = (String, &'static str, &ParameterValue)> {
     let sections = report.instances.iter().flat_map(|instance| {
         instance.profiles.iter().flat_map(move |profile| {
             profile.parameters.iter().flat_map(move |p| {
-                p.judged()
-                    .map(move |(parameter, v)| (format!("{} {}", instance.name, profile.name), parameter.key(), v))
+                p.judged().map(move |(parameter, v)| {
+                    (
+                        format!("{} {}", instance.name, profile.name),
+                        parameter.key(),
+                        v,
+                    )
+                })
             })
         })
     });
@@ -288,9 +298,11 @@ fn failures_text(report: &PartReport) -> String {
     if failures.is_empty() {
         return String::new();
     }
-    let mut text = String::from("
+    let mut text = String::from(
+        "
 out of tolerance:
-");
+",
+    );
     for failure in failures {
         writeln!(text, "  {failure}").expect("writing to a String");
     }

@@ -351,7 +351,10 @@ fn the_summary_names_whose_tolerances_judged_the_parameters_and_lists_each_one_o
     report.instances[1].profiles[0].parameters = Some(parameters);
     // Blade B's mean pitch 1.2 % coarse: outside class I's +-1 %.
     let mut pitch = crate::analysis::section::ParameterValue::of(900.0, 910.8);
-    tolerances.judge(crate::analysis::tolerances::Parameter::BladePitch, &mut pitch);
+    tolerances.judge(
+        crate::analysis::tolerances::Parameter::BladePitch,
+        &mut pitch,
+    );
     report.instances[1].blade_pitch_mm = Some(pitch);
     let (class, cites) = tolerances.class().unwrap();
     report.iso484 = Some(super::ClassUse {

@@ -22,8 +22,8 @@ use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
 use crate::plan::Plan;
 use crate::report::{
-    write_html, write_qif, write_report, ClassUse, InstanceReport, MachineUse, PartReport, PointRecord,
-    ProfileReport, ReferenceUse, Store,
+    write_html, write_qif, write_report, ClassUse, InstanceReport, MachineUse, PartReport,
+    PointRecord, ProfileReport, ReferenceUse, Store,
 };
 
 /// How a finished job ended.
@@ -270,7 +270,9 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no parameters of the section");
                 })
                 .ok();
-            let section_failures = parameters.as_ref().map_or(0, |p| failures(p.judged().map(|(_, v)| v)));
+            let section_failures = parameters
+                .as_ref()
+                .map_or(0, |p| failures(p.judged().map(|(_, v)| v)));
             all.merge(&stats);
             outside += profile_outside;
             profiles.push(ProfileReport {
@@ -312,7 +314,10 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
     let worst_mm = instances
         .iter()
         .map(|i| i.stats.worst_mm)
-        .fold(0.0, |worst: f64, w| if w.abs() > worst.abs() { w } else { worst });
+        .fold(
+            0.0,
+            |worst: f64, w| if w.abs() > worst.abs() { w } else { worst },
+        );
     let verdict = Verdict::combine(instances.iter().map(|i| &i.verdict))
         .with_parameters_outside(failures(propeller_pitch_mm.iter()), worst_mm);
     let settings = &inputs.reference.settings;

@@ -183,7 +183,10 @@ fn parameters_out_of_tolerance_fail_a_verdict_and_are_counted_apart_from_points(
     let json = serde_json::to_string(&points).unwrap();
     assert!(!json.contains("parameters_outside"), "{json}");
     assert_eq!(serde_json::from_str::<Verdict>(&json).unwrap(), points);
-    assert_eq!(points.what_failed().unwrap(), "1 point outside the tolerance");
+    assert_eq!(
+        points.what_failed().unwrap(),
+        "1 point outside the tolerance"
+    );
     let both = points.clone().with_parameters_outside(1, 0.2);
     assert_eq!(
         both,
@@ -193,7 +196,10 @@ fn parameters_out_of_tolerance_fail_a_verdict_and_are_counted_apart_from_points(
             parameters_outside: 1,
         }
     );
-    assert_eq!(Verdict::combine([&both, &failed]).cell_text(), "FAIL (1 outside, 3 parameters)");
+    assert_eq!(
+        Verdict::combine([&both, &failed]).cell_text(),
+        "FAIL (1 outside, 3 parameters)"
+    );
     assert_eq!(points.clone().with_parameters_outside(0, 0.2), points);
     assert_eq!(Verdict::Pass.with_parameters_outside(0, 0.0), Verdict::Pass);
 }

@@ -8,7 +8,12 @@ const CLASSES: [Iso484Class; 4] = [
 ];
 
 /// The verdict on `measured` against `nominal` for `parameter` in `class`.
-fn verdict(class: Iso484Class, parameter: Parameter, nominal: f64, measured: f64) -> ParameterVerdict {
+fn verdict(
+    class: Iso484Class,
+    parameter: Parameter,
+    nominal: f64,
+    measured: f64,
+) -> ParameterVerdict {
     let mut value = ParameterValue::of(nominal, measured);
     ParameterTolerances::new(Some(class), ParameterRules::default()).judge(parameter, &mut value);
     assert_eq!(
@@ -20,7 +25,12 @@ fn verdict(class: Iso484Class, parameter: Parameter, nominal: f64, measured: f64
 
 /// Just inside and just outside each limit (by 0.01 of the parameter's unit): `limits` (lower, upper) worked out
 /// by hand from the class table.
-fn assert_limits(class: Iso484Class, parameter: Parameter, nominal: f64, (lower, upper): (f64, f64)) {
+fn assert_limits(
+    class: Iso484Class,
+    parameter: Parameter,
+    nominal: f64,
+    (lower, upper): (f64, f64),
+) {
     use ParameterVerdict::{Fail, Pass};
     for (measured, expected) in [
         (nominal + upper - 0.01, Pass),
@@ -43,19 +53,39 @@ fn class_verdicts_change_at_the_limits_worked_out_by_hand() {
     assert_limits(Iso484Class::III, Parameter::Pitch, 2000.0, (-100.0, 100.0));
     // A blade's mean pitch, I +-1 %; the propeller's, II +-1 %.
     assert_limits(Iso484Class::I, Parameter::BladePitch, 1500.0, (-15.0, 15.0));
-    assert_limits(Iso484Class::II, Parameter::PropellerPitch, 1500.0, (-15.0, 15.0));
+    assert_limits(
+        Iso484Class::II,
+        Parameter::PropellerPitch,
+        1500.0,
+        (-15.0, 15.0),
+    );
     // Thickness, +2 % / -1 % with a minimum of 2 / 1 mm in S: at 30 mm the minimums hold (0.6 and 0.3 mm are
     // less), at 150 mm the percentages (3 and 1.5 mm are more).
     assert_limits(Iso484Class::S, Parameter::MaxThickness, 30.0, (-1.0, 2.0));
     assert_limits(Iso484Class::S, Parameter::MaxThickness, 150.0, (-1.5, 3.0));
     // III: +6 % / -4 % with a minimum of 6 / 4 mm; at 200 mm, +12 / -8 mm.
-    assert_limits(Iso484Class::III, Parameter::MaxThickness, 200.0, (-8.0, 12.0));
+    assert_limits(
+        Iso484Class::III,
+        Parameter::MaxThickness,
+        200.0,
+        (-8.0, 12.0),
+    );
     // Section length, II +-3 % with a minimum of 13 mm: a 100 mm chord gets +-13 mm, a 500 mm chord +-15 mm.
     assert_limits(Iso484Class::II, Parameter::Chord, 100.0, (-13.0, 13.0));
     assert_limits(Iso484Class::II, Parameter::Chord, 500.0, (-15.0, 15.0));
     // Angular spacing: +-1 deg in I, +-2 deg in II.
-    assert_limits(Iso484Class::I, Parameter::AngularSpacing, 120.0, (-1.0, 1.0));
-    assert_limits(Iso484Class::II, Parameter::AngularSpacing, 120.0, (-2.0, 2.0));
+    assert_limits(
+        Iso484Class::I,
+        Parameter::AngularSpacing,
+        120.0,
+        (-1.0, 1.0),
+    );
+    assert_limits(
+        Iso484Class::II,
+        Parameter::AngularSpacing,
+        120.0,
+        (-2.0, 2.0),
+    );
 }
 
 #[test]
@@ -67,8 +97,16 @@ fn the_class_table_reads_and_every_class_is_looser_than_the_one_before() {
     }
     for pair in CLASSES.windows(2) {
         let (finer, coarser) = (table.rules(pair[0]), table.rules(pair[1]));
-        for ((parameter, name, fine), (_, _, coarse)) in finer.entries().into_iter().zip(coarser.entries()) {
-            assert_eq!(fine.is_some(), coarse.is_some(), "{name} in {} and {}", pair[0], pair[1]);
+        for ((parameter, name, fine), (_, _, coarse)) in
+            finer.entries().into_iter().zip(coarser.entries())
+        {
+            assert_eq!(
+                fine.is_some(),
+                coarse.is_some(),
+                "{name} in {} and {}",
+                pair[0],
+                pair[1]
+            );
             let (Some(fine), Some(coarse)) = (fine, coarse) else {
                 continue;
             };
@@ -160,12 +198,19 @@ fn a_rule_needs_both_sides_each_on_its_side_of_zero() {
     let rule = |text: &str| toml::from_str::<ToleranceRule>(text).unwrap();
     let problem = rule("upper = 0.1").check("chord_mm").unwrap_err();
     assert!(problem.contains("chord_mm has no lower limit"), "{problem}");
-    let problem = rule("lower = 0.1\nupper = 0.2").check("chord_mm").unwrap_err();
+    let problem = rule("lower = 0.1\nupper = 0.2")
+        .check("chord_mm")
+        .unwrap_err();
     assert!(problem.contains("at most 0"), "{problem}");
-    let problem = rule("lower_pct = -1\nupper_pct = -0.5").check("pitch_mm").unwrap_err();
+    let problem = rule("lower_pct = -1\nupper_pct = -0.5")
+        .check("pitch_mm")
+        .unwrap_err();
     assert!(problem.contains("pitch_mm: upper limit -0.5"), "{problem}");
     rule("lower_pct = -1\nupper = 0").check("pitch_mm").unwrap();
     assert!(toml::from_str::<ToleranceRule>("plus = 1").is_err());
     // The percent applies to the nominal's size, whatever its sign (a left-handed propeller's pitch).
-    assert_eq!(rule("lower_pct = -1\nupper_pct = 2").limits(-200.0), (-2.0, 4.0));
+    assert_eq!(
+        rule("lower_pct = -1\nupper_pct = 2").limits(-200.0),
+        (-2.0, 4.0)
+    );
 }
