@@ -89,23 +89,32 @@ impl Verdict {
         Verdict::combine([&self, &failed])
     }
 
-    /// What failed, e.g. "2 points outside the tolerance, 1 parameter out of tolerance"; `None` for a pass.
+    /// What failed, with the worst deviation (mm): "2 points outside the tolerance, worst +0.1200 mm, 1 parameter
+    /// out of tolerance", or "1 parameter out of tolerance (every point within, worst +0.0300 mm)"; `None` for a
+    /// pass.
     pub fn what_failed(&self) -> Option<String> {
         let Verdict::Fail {
             points_outside,
+            worst_mm,
             parameters_outside,
-            ..
         } = self
         else {
             return None;
         };
-        let points = format!(
-            "{} outside the tolerance",
-            counted(*points_outside, "point")
+        let parameters = format!(
+            "{} out of tolerance",
+            counted(*parameters_outside, "parameter")
         );
-        Some(match parameters_outside {
-            0 => points,
-            n => format!("{points}, {} out of tolerance", counted(*n, "parameter")),
+        Some(match (points_outside, parameters_outside) {
+            (0, _) => format!("{parameters} (every point within, worst {worst_mm:+.4} mm)"),
+            (n, 0) => format!(
+                "{} outside the tolerance, worst {worst_mm:+.4} mm",
+                counted(*n, "point")
+            ),
+            (n, _) => format!(
+                "{} outside the tolerance, worst {worst_mm:+.4} mm, {parameters}",
+                counted(*n, "point")
+            ),
         })
     }
 

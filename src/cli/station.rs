@@ -192,8 +192,8 @@ pub fn run_job(job: &JobArgs, request: Request) -> anyhow::Result<Option<Verdict
 /// An inspection's verdict as the command's outcome: a failing part is [`JobEnded::PartFailed`] (exit code 4).
 pub fn judge(part: &str, serial: &str, verdict: Option<Verdict>) -> anyhow::Result<()> {
     match verdict {
-        Some(failed @ Verdict::Fail { worst_mm, .. }) => Err(JobEnded::PartFailed(format!(
-            "part {part} serial {serial}: FAIL, {}, worst {worst_mm:+.3} mm",
+        Some(failed @ Verdict::Fail { .. }) => Err(JobEnded::PartFailed(format!(
+            "part {part} serial {serial}: FAIL, {}",
             failed.what_failed().unwrap_or_default()
         ))
         .into()),

@@ -336,14 +336,9 @@ fn tolerance_text(tolerance: &Tolerance) -> String {
 }
 
 fn verdict_text(verdict: &Verdict) -> String {
-    match verdict {
-        Verdict::Pass => "PASS".to_string(),
-        Verdict::Fail { worst_mm, .. } => format!(
-            "FAIL: {}, worst {}",
-            verdict.what_failed().unwrap_or_default(),
-            deviation_mm(*worst_mm)
-        ),
-    }
+    verdict
+        .what_failed()
+        .map_or_else(|| "PASS".to_string(), |failed| format!("FAIL: {failed}"))
 }
 
 fn verdict_class(verdict: &Verdict) -> &'static str {

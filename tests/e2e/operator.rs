@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use zeroset::api::Event;
 
 use crate::daemon::{job_over, Station};
-use crate::support::{repo, zeroset};
+use crate::support::{propeller_part_edited, repo, zeroset};
 
 /// A command running in the background: its output lines as they come, its exit code at the end.
 struct Background {
@@ -102,12 +102,10 @@ fn with_stdout_closed(
 
 /// config/parts/propeller.toml in `dir` with its tolerance band set to `lower_mm .. upper_mm`.
 fn propeller_part(dir: &Path, lower_mm: f64, upper_mm: f64) {
-    let text = std::fs::read_to_string(repo().join("config/parts/propeller.toml")).unwrap();
-    let mut table: toml::Table = toml::from_str(&text).unwrap();
-    let tolerance = table["tolerance"].as_table_mut().unwrap();
-    tolerance.insert("lower_mm".into(), lower_mm.into());
-    tolerance.insert("upper_mm".into(), upper_mm.into());
-    std::fs::write(dir.join("propeller.toml"), toml::to_string(&table).unwrap()).unwrap();
+    propeller_part_edited(dir, |tolerance| {
+        tolerance.insert("lower_mm".into(), lower_mm.into());
+        tolerance.insert("upper_mm".into(), upper_mm.into());
+    });
 }
 
 #[test]

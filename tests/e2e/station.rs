@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use nalgebra::{Point2, Point3, Rotation3, Vector3};
-use zeroset::api::Event;
+use zeroset::analysis::tolerances::{Iso484Class, ParameterVerdict, ToleranceSource};
+use zeroset::api::{Event, Verdict};
 use zeroset::report::PartReport;
 use zeroset_sim::part::curve::SampledCurve;
 
@@ -15,6 +16,7 @@ use zeroset_sim::part::propeller::PropellerSpec;
 use crate::blade_errors::{assert_parameters_read_the_injected_errors, injected};
 use crate::daemon::{job_over, Station};
 use crate::sim::{propeller, propeller_spec};
+use crate::support::propeller_part_edited;
 
 /// The agreement the issue asks for between measured and injected errors, mm.
 const AGREEMENT_MM: f64 = 0.005;
@@ -212,16 +214,124 @@ fn assert_best_fits_recover_the_blade_errors(
 }
 
 /// Blades of the wrong thickness, chord and camber (config/sims/propeller-shape-errors.toml), in their places:
-/// each section's parameters read the simulator's scales back, and the spacings read 120 deg.
+/// each section's parameters read the simulator's scales back, and the spacings read 120 deg. Judged by ISO 484
+/// class S (the committed part file's) with the maximum thickness held to +-0.5 % by the part file and every point
+/// allowed +-1 mm, blade A passes, and B (1.1 to 1.9 % thick) and C (1 % thin) fail on their thickness alone.
 #[test]
-fn inspect_reads_back_blades_of_the_wrong_thickness_chord_and_camber() {
-    let station = Station::start("propeller-shape-errors.toml");
+fn inspect_reads_back_blades_of_the_wrong_thickness_chord_and_camber_and_judges_them() {
+    let parts = tempfile::tempdir().unwrap();
+    propeller_part_edited(parts.path(), |tolerance| {
+        tolerance.insert("lower_mm".into(), (-1.0).into());
+        tolerance.insert("upper_mm".into(), 1.0.into());
+        let parameters = tolerance["parameters"].as_table_mut().unwrap();
+        let mut thickness = toml::Table::new();
+        thickness.insert("lower_pct".into(), (-0.5).into());
+        thickness.insert("upper_pct".into(), 0.5.into());
+        parameters.insert("max_thickness_mm".into(), thickness.into());
+    });
+    let folder = parts.path().display().to_string();
+    let station = Station::start_edited("propeller-shape-errors.toml", "station.toml", |table| {
+        table.insert("parts".into(), folder.into());
+    });
     teach(&station);
-    let out = station.inspected(&["inspect", "propeller", "--serial", "SN-2"]);
-    assert!(out.contains("report: "), "{out}");
+    let watch = station.spawn(&["watch"]);
+    let run = station.cli(&["inspect", "propeller", "--serial", "SN-2"]);
+    let watched = watch.wait_with_output().expect("watch ends with the job");
+    let watched = String::from_utf8_lossy(&watched.stdout);
     let (_, report) = station.report("SN-2");
     let spec = propeller_spec("propeller-shape-errors.toml");
     assert_parameters_read_the_injected_errors(&report, &spec, &station.daemon_log());
+
+    assert_eq!(run.code, Some(4), "{}\n{}", run.stdout, run.stderr);
+    assert!(
+        run.stderr.starts_with(
+            "part propeller serial SN-2: FAIL, 10 parameters out of tolerance (every point within, worst "
+        ),
+        "{}",
+        run.stderr
+    );
+    for instance in &report.instances {
+        let thick = instance.name != "A";
+        for profile in &instance.profiles {
+            let what = format!("blade {} profile {}", instance.name, profile.name);
+            let p = profile.parameters.as_ref().expect("parameters");
+            let thickness = &p.max_thickness_mm;
+            let tolerance = thickness.tolerance.as_ref().expect("a thickness tolerance");
+            let limit = 0.005 * thickness.nominal;
+            assert!(
+                (tolerance.lower + limit).abs() < 1e-9 && (tolerance.upper - limit).abs() < 1e-9,
+                "{what}: {tolerance:?}, +-0.5 % of {}",
+                thickness.nominal
+            );
+            assert_eq!(tolerance.from, ToleranceSource::PartFile, "{what}");
+            let expected = if thick {
+                ParameterVerdict::Fail
+            } else {
+                ParameterVerdict::Pass
+            };
+            assert_eq!(thickness.verdict, Some(expected), "{what}: {thickness:?}");
+            assert_eq!(p.verdict, Some(expected), "{what}");
+            // The class judges the section's pitch and chord: within S's +-1 % and +-1.5 % (min 7 mm).
+            for (name, value) in [
+                ("pitch", p.pitch_mm.as_ref().expect("a pitch")),
+                ("chord", &p.chord_mm),
+            ] {
+                let tolerance = value.tolerance.as_ref().expect("a class tolerance");
+                assert_eq!(
+                    tolerance.from,
+                    ToleranceSource::Iso484(Iso484Class::S),
+                    "{what} {name}"
+                );
+                assert_eq!(
+                    value.verdict,
+                    Some(ParameterVerdict::Pass),
+                    "{what} {name}: {value:?}"
+                );
+            }
+            let line = watched
+                .lines()
+                .find(|l| {
+                    l.starts_with(&format!("{} {}: ", instance.name, profile.name))
+                        && l.contains("off nominal")
+                })
+                .unwrap_or_else(|| panic!("{what}: no section line in watch's output:\n{watched}"));
+            let sources = "(ISO 484 class S and the part file)";
+            if thick {
+                assert!(
+                    line.contains(&format!(": FAIL {sources}: max_thickness_mm "))
+                        && line.contains(" mm outside ["),
+                    "{what}: {line}"
+                );
+            } else {
+                assert!(
+                    line.ends_with(&format!(": PASS {sources}")),
+                    "{what}: {line}"
+                );
+            }
+        }
+        let spacing = instance.angular_spacing_deg.as_ref().expect("a spacing");
+        assert_eq!(
+            spacing.verdict,
+            Some(ParameterVerdict::Pass),
+            "blade {}",
+            instance.name
+        );
+        match (thick, &instance.verdict) {
+            (false, Verdict::Pass) => {}
+            (
+                true,
+                Verdict::Fail {
+                    points_outside: 0,
+                    parameters_outside: 5,
+                    ..
+                },
+            ) => {}
+            (_, verdict) => panic!("blade {}: {verdict:?}", instance.name),
+        }
+    }
+    let (report_dir, _) = station.report("SN-2");
+    let summary = std::fs::read_to_string(report_dir.join("summary.txt")).unwrap();
+    assert!(summary.contains("out of tolerance:"), "{summary}");
 }
 
 #[test]

@@ -171,7 +171,7 @@ fn parameters_out_of_tolerance_fail_a_verdict_and_are_counted_apart_from_points(
     );
     assert_eq!(
         failed.what_failed().unwrap(),
-        "0 points outside the tolerance, 2 parameters out of tolerance"
+        "2 parameters out of tolerance (every point within, worst -0.0300 mm)"
     );
     assert_eq!(failed.cell_text(), "FAIL (0 outside, 2 parameters)");
     let points = Verdict::Fail {
@@ -185,7 +185,15 @@ fn parameters_out_of_tolerance_fail_a_verdict_and_are_counted_apart_from_points(
     assert_eq!(serde_json::from_str::<Verdict>(&json).unwrap(), points);
     assert_eq!(
         points.what_failed().unwrap(),
-        "1 point outside the tolerance"
+        "1 point outside the tolerance, worst +0.2000 mm"
+    );
+    assert_eq!(
+        points
+            .clone()
+            .with_parameters_outside(1, 0.2)
+            .what_failed()
+            .unwrap(),
+        "1 point outside the tolerance, worst +0.2000 mm, 1 parameter out of tolerance"
     );
     let both = points.clone().with_parameters_outside(1, 0.2);
     assert_eq!(
