@@ -5,10 +5,14 @@ use std::fmt::Write;
 use std::path::Path;
 
 use super::plots::{deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures};
-use super::summary::{deviation, machine_text, COORDINATE_DECIMALS, DEVIATION_DECIMALS};
+use super::summary::{
+    deviation, machine_text, parameter_failures, parameter_tolerances_text, COORDINATE_DECIMALS,
+    DEVIATION_DECIMALS,
+};
 use super::{PartReport, ProfileReport};
 use crate::analysis::section::{ParameterValue, SectionParametersReport};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
+use crate::analysis::tolerances::ParameterVerdict;
 use crate::fsutil::write_atomically;
 
 pub const HTML_FILE: &str = "report.html";
@@ -76,7 +80,8 @@ fn header_html(report: &PartReport) -> String {
             "all lengths in mm; deviations positive outside the material".to_string(),
         ),
     ];
-    for (label, value) in rows {
+    let parameters = parameter_tolerances_text(report).map(|text| ("parameter tolerances", text));
+    for (label, value) in rows.into_iter().chain(parameters) {
         writeln!(html, "<dt>{label}</dt><dd>{}</dd>", escape(&value)).expect("writing to a String");
     }
     html.push_str("</dl>\n");
@@ -179,10 +184,9 @@ fn parameters_table(report: &PartReport) -> String {
          edge; camber and chord angle (to the plane of rotation, +y) from the mean line; pitch 2 &pi; r tan(chord \
          angle).</p>\n<table>\n<tr><th>instance</th><th>profile</th><th>chord</th><th>max thickness</th>\
          <th>leading-edge thickness</th><th>trailing-edge thickness</th><th>max camber</th><th>chord angle</th>\
-         <th>pitch</th></tr>\n"
+         <th>pitch</th><th>parameters</th></tr>\n"
     );
-    let value =
-        |v: &ParameterValue, unit: &str| format!("{:.4} {unit} ({:+.4})", v.measured, v.deviation);
+    let value = parameter_cell;
     for (instance, profile, p) in rows {
         let cells = [
             escape(instance),
@@ -196,40 +200,99 @@ fn parameters_table(report: &PartReport) -> String {
             p.pitch_mm
                 .as_ref()
                 .map_or_else(|| "-".to_string(), |v| value(v, "mm")),
+            p.verdict
+                .map_or_else(|| "-".to_string(), parameter_verdict_html),
         ];
         html.push_str(&cells_row(cells));
     }
     html.push_str("</table>\n");
+    html.push_str(&failures_list(report));
     html
 }
 
-/// Each blade's turn about the hub axis off its place and its angular spacing from the blade before it; nothing for
-/// parts that have none.
+/// A parameter's cell: measured (deviation from nominal); where it has a tolerance, marked pass or fail with the
+/// limits and whose they are below.
+fn parameter_cell(v: &ParameterValue, unit: &str) -> String {
+    let text = format!("{:.4} {unit} ({:+.4})", v.measured, v.deviation);
+    match (v.tolerance, v.verdict) {
+        (Some(tolerance), Some(verdict)) => format!(
+            "<span class=\"{}\">{text}</span><br><small>[{:+.4}, {:+.4}] {unit}, {}</small>",
+            parameter_verdict_class(verdict),
+            tolerance.lower,
+            tolerance.upper,
+            escape(&tolerance.from.to_string())
+        ),
+        _ => text,
+    }
+}
+
+fn parameter_verdict_class(verdict: ParameterVerdict) -> &'static str {
+    match verdict {
+        ParameterVerdict::Pass => "pass",
+        ParameterVerdict::Fail => "fail",
+    }
+}
+
+fn parameter_verdict_html(verdict: ParameterVerdict) -> String {
+    let class = parameter_verdict_class(verdict);
+    format!("<span class=\"{class}\">{}</span>", class.to_uppercase())
+}
+
+/// Every parameter out of tolerance, as the summary lists them; nothing when none is.
+fn failures_list(report: &PartReport) -> String {
+    let failures = parameter_failures(report);
+    if failures.is_empty() {
+        return String::new();
+    }
+    let items: String = failures
+        .iter()
+        .map(|f| format!("<li class=\"fail\">{}</li>\n", escape(f)))
+        .collect();
+    format!("<h2>Parameters out of tolerance</h2>\n<ul>\n{items}</ul>\n")
+}
+
+/// Each blade's turn about the hub axis off its place, its angular spacing from the blade before it and its mean
+/// pitch, then the propeller's mean pitch; nothing for parts that have none.
 fn spacings_table(report: &PartReport) -> String {
     let rows: Vec<String> = report
         .instances
         .iter()
-        .filter_map(|i| {
-            let spacing = i.angular_spacing_deg?;
+        .filter(|i| i.angular_spacing_deg.is_some() || i.blade_pitch_mm.is_some())
+        .map(|i| {
             let turned = i
                 .index_deg
                 .map_or_else(|| "-".into(), |t| format!("{t:+.4} deg"));
-            Some(cells_row([
+            let spacing = i.angular_spacing_deg.as_ref();
+            cells_row([
                 escape(&i.name),
                 turned,
-                format!("{:.4} deg ({:+.4})", spacing.measured, spacing.deviation),
-                format!("{:.4} deg", spacing.nominal),
-            ]))
+                spacing.map_or_else(|| "-".into(), |s| parameter_cell(s, "deg")),
+                spacing.map_or_else(|| "-".into(), |s| format!("{:.4} deg", s.nominal)),
+                i.blade_pitch_mm
+                    .as_ref()
+                    .map_or_else(|| "-".into(), |p| parameter_cell(p, "mm")),
+            ])
         })
         .collect();
     if rows.is_empty() {
         return String::new();
     }
+    let propeller = report
+        .propeller_pitch_mm
+        .as_ref()
+        .map_or_else(String::new, |p| {
+            format!(
+                "<p>Propeller mean pitch (the mean of its blades', nominal {:.4} mm): {}</p>\n",
+                p.nominal,
+                parameter_cell(p, "mm")
+            )
+        });
     format!(
-        "<h2>Blade places</h2>\n<p>Each blade's turn about the hub axis off its place, from how far its sections' \
-         chord middles lie along the tangent (r tan(turn) at radius r), and its angular spacing from the blade \
-         before it (the first from the last).</p>\n<table>\n<tr><th>blade</th><th>turned</th><th>angular spacing \
-         (deviation)</th><th>nominal</th></tr>\n{}</table>\n",
+        "<h2>Blade places and pitch</h2>\n<p>Each blade's turn about the hub axis off its place, from how far its \
+         sections' chord middles lie along the tangent (r tan(turn) at radius r), its angular spacing from the blade \
+         before it (the first from the last), and its mean pitch, the mean of its sections'.</p>\n<table>\n<tr>\
+         <th>blade</th><th>turned</th><th>angular spacing (deviation)</th><th>nominal</th><th>mean pitch \
+         (deviation)</th></tr>\n{}</table>\n{propeller}",
         rows.concat()
     )
 }

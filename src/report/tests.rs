@@ -330,13 +330,13 @@ pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParameters
     }
 }
 
-#[test]
-fn the_summary_names_whose_tolerances_judged_the_parameters_and_lists_each_one_out_of_them() {
+/// `report`'s second instance, first profile given [`sample_parameters`] judged by ISO 484 class I with the maximum
+/// thickness held to +-0.03 mm by the part file (it fails, at -0.0382 mm), and a blade mean pitch 1.2 % coarse
+/// (outside class I's +-1 %).
+pub(crate) fn judge_a_sample_blade(report: &mut super::PartReport) {
     use crate::analysis::tolerances::{
-        Iso484Class, ParameterRules, ParameterTolerances, ToleranceRule,
+        Iso484Class, Parameter, ParameterRules, ParameterTolerances, ToleranceRule,
     };
-    let mut report = sample_report();
-    assert!(!summary_text(&report).contains("parameter tolerances"));
     let thin = ParameterRules {
         max_thickness_mm: Some(ToleranceRule {
             lower: Some(-0.03),
@@ -349,18 +349,21 @@ fn the_summary_names_whose_tolerances_judged_the_parameters_and_lists_each_one_o
     let mut parameters = sample_parameters();
     tolerances.judge_section(&mut parameters);
     report.instances[1].profiles[0].parameters = Some(parameters);
-    // Blade B's mean pitch 1.2 % coarse: outside class I's +-1 %.
     let mut pitch = crate::analysis::section::ParameterValue::of(900.0, 910.8);
-    tolerances.judge(
-        crate::analysis::tolerances::Parameter::BladePitch,
-        &mut pitch,
-    );
+    tolerances.judge(Parameter::BladePitch, &mut pitch);
     report.instances[1].blade_pitch_mm = Some(pitch);
     let (class, cites) = tolerances.class().unwrap();
     report.iso484 = Some(super::ClassUse {
         class,
         cites: cites.into(),
     });
+}
+
+#[test]
+fn the_summary_names_whose_tolerances_judged_the_parameters_and_lists_each_one_out_of_them() {
+    let mut report = sample_report();
+    assert!(!summary_text(&report).contains("parameter tolerances"));
+    judge_a_sample_blade(&mut report);
     let text = summary_text(&report);
     assert!(
         text.contains(

@@ -331,7 +331,24 @@ fn inspect_reads_back_blades_of_the_wrong_thickness_chord_and_camber_and_judges_
     }
     let (report_dir, _) = station.report("SN-2");
     let summary = std::fs::read_to_string(report_dir.join("summary.txt")).unwrap();
-    assert!(summary.contains("out of tolerance:"), "{summary}");
+    let listed = summary
+        .lines()
+        .filter(|l| l.contains("max_thickness_mm ") && l.ends_with(" (the part file)"));
+    assert_eq!(
+        listed.count(),
+        10,
+        "B's and C's sections listed out of tolerance:\n{summary}"
+    );
+    let html = std::fs::read_to_string(report_dir.join("report.html")).unwrap();
+    assert_eq!(
+        html.matches("<li class=\"fail\">").count(),
+        10,
+        "B's and C's sections listed out of tolerance in report.html"
+    );
+    assert!(
+        html.contains("<dt>parameter tolerances</dt>"),
+        "report.html names the tolerances"
+    );
 }
 
 #[test]

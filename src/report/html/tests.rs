@@ -308,7 +308,7 @@ fn the_blade_table_shows_each_sections_parameters_measured_and_off_nominal() {
     let html = report_html(&report).unwrap();
     for cell in [
         "<td>B</td><td>r100</td><td>172.8700 mm (+0.0200)</td><td>20.7001 mm (-0.0382)</td>",
-        "<td>55.0475 deg (-0.0293)</td><td>898.6200 mm (-1.2770)</td></tr>",
+        "<td>55.0475 deg (-0.0293)</td><td>898.6200 mm (-1.2770)</td><td>-</td></tr>",
         "edge thicknesses 2 mm in from each edge",
     ] {
         assert!(html.contains(cell), "{cell} not in the page");
@@ -329,11 +329,33 @@ fn the_blade_places_table_gives_each_blades_turn_and_spacing() {
         120.0, 120.0099,
     ));
     let html = report_html(&report).unwrap();
-    let row = "<tr><td>C</td><td>+0.0101 deg</td><td>120.0099 deg (+0.0099)</td><td>120.0000 deg</td></tr>";
+    let row = "<tr><td>C</td><td>+0.0101 deg</td><td>120.0099 deg (+0.0099)</td><td>120.0000 deg</td><td>-</td></tr>";
     assert!(html.contains(row), "{row} not in the page");
     assert_eq!(
         html.matches("<tr><td>A</td><td>").count(),
         0,
         "only C has a spacing"
     );
+}
+
+#[test]
+fn toleranced_parameters_are_marked_with_their_limits_and_each_failure_listed() {
+    let mut report = three_blades();
+    crate::report::tests::judge_a_sample_blade(&mut report);
+    let html = report_html(&report).unwrap();
+    for text in [
+        "<dt>parameter tolerances</dt><dd>the part file&#39;s [tolerance.parameters], else ISO 484 class I (",
+        // The thickness fails the part file's +-0.03 mm; the chord passes class I's +-2 % (min 10 mm).
+        "<td><span class=\"fail\">20.7001 mm (-0.0382)</span><br><small>[-0.0300, +0.0300] mm, the part file</small></td>",
+        "<td><span class=\"pass\">172.8700 mm (+0.0200)</span><br><small>[-10.0000, +10.0000] mm, ISO 484 class I</small></td>",
+        // The edge thicknesses have no tolerance: plain.
+        "<td>6.3894 mm (-0.0134)</td>",
+        "<td><span class=\"fail\">FAIL</span></td></tr>",
+        "<span class=\"fail\">910.8000 mm (+10.8000)</span><br><small>[-9.0000, +9.0000] mm, ISO 484 class I</small>",
+        "<h2>Parameters out of tolerance</h2>",
+        "<li class=\"fail\">B r100: max_thickness_mm -0.0382 mm outside [-0.0300, +0.0300] mm (the part file)</li>",
+        "<li class=\"fail\">blade B: blade_pitch_mm +10.8000 mm outside [-9.0000, +9.0000] mm (ISO 484 class I)</li>",
+    ] {
+        assert!(html.contains(text), "{text} not in the page:\n{html}");
+    }
 }
