@@ -8,6 +8,7 @@
 //! The peers need python3 with numpy and scipy; without them their entries are skipped with a message.
 
 mod data;
+mod demo_propeller;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -15,14 +16,12 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode};
-use nalgebra::{Point3, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use zeroset::analysis::reference::{teach, MasterProfile, ReferenceSettings};
+use zeroset::analysis::reference::{teach, ReferenceSettings};
 use zeroset::geometry::fit3l::{fit_ip, FitMethod, FitOptions};
 use zeroset::geometry::normals::{ordered_profile_normals, pca_normals};
-use zeroset_sim::config::{PartSpec, SimConfig};
-use zeroset_sim::part::Plane;
 
 /// `count` points on r(theta, phi) = 50 (1 + 0.1 sin 3 theta cos 2 phi) mm, with 2 um noise along the radius.
 fn blob(count: usize) -> Vec<Vector3<f64>> {
@@ -37,50 +36,6 @@ fn blob(count: usize) -> Vec<Vector3<f64>> {
             let r = 50.0 * (1.0 + 0.1 * (3.0 * theta).sin() * (2.0 * phi).cos())
                 + noise.sample(&mut rng);
             Vector3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), z) * r
-        })
-        .collect()
-}
-
-/// The master's scan of the demo propeller (config/sims/propeller.toml, blade A): the five sections of
-/// config/parts/propeller.toml at the part's scan step (1 mm), 2 um noise along the normal.
-fn demo_master_profiles() -> Vec<MasterProfile> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let sim = SimConfig::load(&root.join("config/sims/propeller.toml")).expect("sim config");
-    let part = sim.parts["propeller"].build().expect("propeller");
-    assert!(matches!(sim.parts["propeller"], PartSpec::Propeller(_)));
-    let mut rng = rand::rngs::StdRng::seed_from_u64(4412);
-    let noise = Normal::new(0.0, 0.002).expect("sigma");
-    [100.0, 200.0, 300.0, 400.0, 500.0]
-        .iter()
-        .map(|&x| {
-            let plane = Plane {
-                point: Point3::new(x, 0.0, 0.0),
-                normal: Vector3::x(),
-            };
-            let section = part.section(&plane).expect("the plane cuts blade A");
-            let dense = section.curve.dense(4000);
-            let length: f64 = (0..dense.len())
-                .map(|i| (dense[(i + 1) % dense.len()].point - dense[i].point).norm())
-                .sum();
-            let frame = section.frame;
-            let (points, normals) = section
-                .curve
-                .dense(length.round() as usize)
-                .iter()
-                .map(|c| {
-                    let p = c.point.coords + c.normal * noise.sample(&mut rng);
-                    (
-                        frame.world(p.x, p.y, 0.0),
-                        frame.world_dir(c.normal.x, c.normal.y, 0.0),
-                    )
-                })
-                .unzip();
-            MasterProfile {
-                name: format!("r{x}"),
-                x_mm: x,
-                points,
-                normals,
-            }
         })
         .collect()
 }
@@ -178,7 +133,7 @@ fn surface_fits(c: &mut Criterion) {
 }
 
 fn teach_fits(c: &mut Criterion) {
-    let profiles = demo_master_profiles();
+    let profiles = demo_propeller::master_profiles();
     let settings = ReferenceSettings::ImplicitPolynomial {
         degree: 8,
         method: FitMethod::Orthogonal,
