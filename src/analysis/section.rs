@@ -227,6 +227,12 @@ pub struct SectionParametersReport {
     pub max_thickness_at: ParameterValue,
     pub le_thickness_mm: ParameterValue,
     pub te_thickness_mm: ParameterValue,
+    /// The radius of each edge's round (a circle fitted at its tip), where both the nominal's and the scan's are
+    /// round; absent at a sharp edge and in older reports.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub le_radius_mm: Option<ParameterValue>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub te_radius_mm: Option<ParameterValue>,
     pub max_camber_mm: ParameterValue,
     pub max_camber_at: ParameterValue,
     pub chord_angle_deg: ParameterValue,
@@ -255,6 +261,8 @@ impl SectionParametersReport {
             (Parameter::ChordAngle, &self.chord_angle_deg),
         ]
         .into_iter()
+        .chain(self.le_radius_mm.as_ref().map(|r| (Parameter::LeRadius, r)))
+        .chain(self.te_radius_mm.as_ref().map(|r| (Parameter::TeRadius, r)))
         .chain(self.pitch_mm.as_ref().map(|p| (Parameter::Pitch, p)))
     }
 
@@ -276,6 +284,8 @@ impl SectionParametersReport {
             (Parameter::ChordAngle, &mut self.chord_angle_deg),
         ]
         .into_iter()
+        .chain(self.le_radius_mm.as_mut().map(|r| (Parameter::LeRadius, r)))
+        .chain(self.te_radius_mm.as_mut().map(|r| (Parameter::TeRadius, r)))
         .chain(self.pitch_mm.as_mut().map(|p| (Parameter::Pitch, p)))
     }
 }
@@ -291,6 +301,9 @@ pub fn parameters(
     let measured = section_parameters(&in_plane, EDGE_DISTANCE_MM).map_err(|e| e.to_string())?;
     let value =
         |read: fn(&SectionParameters) -> f64| ParameterValue::of(read(nominal), read(&measured));
+    let radius = |read: fn(&SectionParameters) -> Option<f64>| {
+        Some(ParameterValue::of(read(nominal)?, read(&measured)?))
+    };
     let pitch = |p: &SectionParameters, r: f64| {
         std::f64::consts::TAU * r * p.mean_line.chord_angle_deg.to_radians().tan()
     };
@@ -301,6 +314,8 @@ pub fn parameters(
         max_thickness_at: value(|p| p.max_thickness_at),
         le_thickness_mm: value(|p| p.le_thickness_mm),
         te_thickness_mm: value(|p| p.te_thickness_mm),
+        le_radius_mm: radius(|p| p.le_radius_mm),
+        te_radius_mm: radius(|p| p.te_radius_mm),
         max_camber_mm: value(|p| p.mean_line.max_camber_mm),
         max_camber_at: value(|p| p.mean_line.max_camber_at),
         chord_angle_deg: value(|p| p.mean_line.chord_angle_deg),

@@ -101,6 +101,8 @@ pub(crate) enum Parameter {
     MaxThickness,
     LeThickness,
     TeThickness,
+    LeRadius,
+    TeRadius,
     MaxCamber,
     ChordAngle,
     Pitch,
@@ -132,6 +134,11 @@ pub struct ParameterRules {
     pub le_thickness_mm: Option<ToleranceRule>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub te_thickness_mm: Option<ToleranceRule>,
+    /// The edges' radii, where they are round.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub le_radius_mm: Option<ToleranceRule>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub te_radius_mm: Option<ToleranceRule>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_camber_mm: Option<ToleranceRule>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -151,7 +158,7 @@ pub struct ParameterRules {
 }
 
 impl ParameterRules {
-    fn entries(&self) -> [(Parameter, &'static str, Option<ToleranceRule>); 10] {
+    fn entries(&self) -> [(Parameter, &'static str, Option<ToleranceRule>); 12] {
         [
             (Parameter::Chord, "chord_mm", self.chord_mm),
             (
@@ -169,6 +176,8 @@ impl ParameterRules {
                 "te_thickness_mm",
                 self.te_thickness_mm,
             ),
+            (Parameter::LeRadius, "le_radius_mm", self.le_radius_mm),
+            (Parameter::TeRadius, "te_radius_mm", self.te_radius_mm),
             (Parameter::MaxCamber, "max_camber_mm", self.max_camber_mm),
             (
                 Parameter::ChordAngle,

@@ -1,6 +1,7 @@
 //! The geometry kernel: pure mathematics, no I/O. Implicit polynomials, their fitting, distances to their zero
 //! sets and profile interpolation. Nothing here imports from the station.
 
+pub(crate) mod circle;
 pub mod distance;
 pub mod fit3l;
 pub mod implicit;

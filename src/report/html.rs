@@ -181,9 +181,12 @@ fn parameters_table(report: &PartReport) -> String {
     let mut html = format!(
         "<h2>Section parameters, measured (deviation from nominal)</h2>\n<p>Chord between the two points farthest \
          apart; maximum thickness the largest inscribed circle; edge thicknesses {edge_distance_mm} mm in from each \
-         edge; camber and chord angle (to the plane of rotation, +y) from the mean line; pitch 2 &pi; r tan(chord \
+         edge; edge radii from a circle fitted at each round tip (from the scan's few points round a nose, repeatable \
+         to about 0.1 mm: see BENCHMARKS.md); camber and chord angle (to the plane of rotation, +y) \
+         from the mean line; pitch 2 &pi; r tan(chord \
          angle).</p>\n<table>\n<tr><th>instance</th><th>profile</th><th>chord</th><th>max thickness</th>\
-         <th>leading-edge thickness</th><th>trailing-edge thickness</th><th>max camber</th><th>chord angle</th>\
+         <th>leading-edge thickness</th><th>trailing-edge thickness</th><th>leading-edge radius</th>\
+         <th>trailing-edge radius</th><th>max camber</th><th>chord angle</th>\
          <th>pitch</th><th>parameters</th></tr>\n"
     );
     let value = parameter_cell;
@@ -195,6 +198,8 @@ fn parameters_table(report: &PartReport) -> String {
             value(&p.max_thickness_mm, "mm"),
             value(&p.le_thickness_mm, "mm"),
             value(&p.te_thickness_mm, "mm"),
+            radius_cell(p.le_radius_mm.as_ref()),
+            radius_cell(p.te_radius_mm.as_ref()),
             value(&p.max_camber_mm, "mm"),
             value(&p.chord_angle_deg, "deg"),
             p.pitch_mm
@@ -208,6 +213,11 @@ fn parameters_table(report: &PartReport) -> String {
     html.push_str("</table>\n");
     html.push_str(&failures_list(report));
     html
+}
+
+/// An edge radius' cell; "sharp" where the edge (nominal or scanned) has no round.
+fn radius_cell(radius: Option<&ParameterValue>) -> String {
+    radius.map_or_else(|| "sharp".to_string(), |r| parameter_cell(r, "mm"))
 }
 
 /// A parameter's cell: measured (deviation from nominal); where it has a tolerance, marked pass or fail with the

@@ -321,6 +321,9 @@ pub(crate) fn sample_parameters() -> crate::analysis::section::SectionParameters
         max_thickness_at: value(0.3, 0.301),
         le_thickness_mm: value(6.4028, 6.3894),
         te_thickness_mm: value(0.5804, 0.5765),
+        // A round nose, a sharp trailing edge.
+        le_radius_mm: Some(value(2.9214, 2.9066)),
+        te_radius_mm: None,
         max_camber_mm: value(6.9075, 6.9073),
         max_camber_at: value(0.4, 0.4),
         chord_angle_deg: value(55.0768, 55.0475),

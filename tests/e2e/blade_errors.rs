@@ -75,8 +75,8 @@ pub fn assert_parameters_read_the_injected_errors(
                 made.pitch_mm.0
             );
             println!(
-                "{what}: chord {:?}, thickness {:?}, camber {:?}, angle {:?}, pitch {pitch:?}, le {:?}, te {:?}",
-                p.chord_mm, p.max_thickness_mm, p.max_camber_mm, p.chord_angle_deg, p.le_thickness_mm, p.te_thickness_mm
+                "{what}: chord {:?}, thickness {:?}, camber {:?}, angle {:?}, pitch {pitch:?}, le {:?}, te {:?}, le radius {:?}, te radius {:?}",
+                p.chord_mm, p.max_thickness_mm, p.max_camber_mm, p.chord_angle_deg, p.le_thickness_mm, p.te_thickness_mm, p.le_radius_mm, p.te_radius_mm
             );
             // The edge thicknesses are taken a fixed distance in from each edge: on a chord of another length that
             // is another station, so they are compared only where the chord is kept.

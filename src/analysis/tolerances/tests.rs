@@ -138,6 +138,8 @@ fn section(chord: (f64, f64), thickness: (f64, f64)) -> SectionParametersReport 
         max_thickness_at: value((0.3, 0.3)),
         le_thickness_mm: value((5.0, 5.0)),
         te_thickness_mm: value((1.0, 1.0)),
+        le_radius_mm: None,
+        te_radius_mm: None,
         max_camber_mm: value((2.0, 2.0)),
         max_camber_at: value((0.4, 0.4)),
         chord_angle_deg: value((40.0, 40.0)),

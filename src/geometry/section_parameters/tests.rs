@@ -257,3 +257,56 @@ fn noise_of_2_um_moves_the_chord_angle_by_under_3_millidegrees_where_the_two_far
         "{worst_farthest} against {worst}"
     );
 }
+
+/// A stadium: a 100 mm long bar with round ends of radius `r`, counter-clockwise, about 0.05 mm between points.
+fn stadium(r: f64) -> Vec<Vector2<f64>> {
+    let mut points = Vec::new();
+    let straight = 100.0 - 2.0 * r;
+    for k in 0..2 {
+        let (centre, from) = if k == 0 {
+            (Vector2::new(straight / 2.0, 0.0), -90f64)
+        } else {
+            (Vector2::new(-straight / 2.0, 0.0), 90f64)
+        };
+        for i in 0..=180 {
+            let a = (from + i as f64).to_radians();
+            points.push(centre + Vector2::new(a.cos(), a.sin()) * r);
+        }
+        let sign = if k == 0 { -1.0 } else { 1.0 };
+        for i in 1..(straight / 0.5) as usize {
+            points.push(Vector2::new(
+                -sign * (straight / 2.0 - 0.5 * i as f64),
+                -sign * r,
+            ));
+        }
+    }
+    points
+}
+
+#[test]
+fn round_edges_have_their_radius_and_a_sharp_one_none() {
+    // A stadium's ends are circles: both radii exact, wherever it lies.
+    let outline = moved(&stadium(3.0), 33.0, Vector2::new(-250.0, 80.0));
+    let p = section_parameters(&noisy(&outline, 0.002, 5), 2.0).unwrap();
+    for radius in [p.le_radius_mm, p.te_radius_mm] {
+        let radius = radius.expect("a round end");
+        assert!((radius - 3.0).abs() < 0.005, "{radius}");
+    }
+    // NACA 0012 of chord 100 mm: nose radius 1.1019 t^2 c = 1.5867 mm (its published value); the closed trailing
+    // edge is a corner and has none. NACA's half-thickness 0.2969 sqrt(x) - 0.1260 x ... bends away from its
+    // osculating circle at first order, so the circle fitted over a quarter of the radius is 6 % wider (1.686
+    // mm); on a round nose whose curvature is stationary at the tip (the stadium's) the two agree.
+    let p = section_parameters(&noisy(&naca("0012", 2000), 0.002, 6), 2.0).unwrap();
+    let le = p.le_radius_mm.expect("a round nose");
+    assert!(le > 1.5867 && le < 1.5867 * 1.07, "{le}");
+    assert_eq!(p.te_radius_mm, None);
+    // Twice as thick, four times the osculating nose radius (r ~ t^2); the fitted circle's zone follows the
+    // radius, on a stretched outline that is not the same shape, so it grows 3.7 times.
+    let thick = section_parameters(&naca("0024", 2000), 2.0).unwrap();
+    let ratio = thick.le_radius_mm.unwrap()
+        / section_parameters(&naca("0012", 2000), 2.0)
+            .unwrap()
+            .le_radius_mm
+            .unwrap();
+    assert!(ratio > 3.5 && ratio < 4.0, "{ratio}");
+}

@@ -5,7 +5,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use nalgebra::{DMatrix, DVector, Point2};
+use nalgebra::Point2;
 
 /// Angular bins the radii are averaged in first, so that where a scan is dense does not weigh more.
 const BINS: usize = 720;
@@ -67,17 +67,8 @@ pub fn strongest(
 /// squares). For an outline with two or more lobes it is the outline's centre however the scan is spread along
 /// it, where the points' centroid would lean towards where they are dense.
 pub fn circle_centre(points: &[Point2<f64>]) -> Point2<f64> {
-    let rows = DMatrix::from_fn(points.len(), 3, |i, j| match j {
-        0 => points[i].x,
-        1 => points[i].y,
-        _ => 1.0,
-    });
-    let rhs = DVector::from_fn(points.len(), |i, _| -points[i].coords.norm_squared());
-    let solution = rows
-        .svd(true, true)
-        .solve(&rhs, 1e-12)
-        .expect("an SVD with both factors solves");
-    Point2::new(-solution[0] / 2.0, -solution[1] / 2.0)
+    let points: Vec<_> = points.iter().map(|p| p.coords).collect();
+    Point2::from(crate::geometry::circle::algebraic_centre(&points))
 }
 
 #[cfg(test)]
