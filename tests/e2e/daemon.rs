@@ -214,12 +214,17 @@ impl Station {
 
     /// `zeroset ARGS --config STATION` in the background, its standard output and error piped.
     pub fn spawn(&self, args: &[&str]) -> Child {
+        self.spawn_with_stdout(args, Stdio::piped())
+    }
+
+    /// `zeroset ARGS --config STATION` in the background writing to `stdout`, its standard error piped.
+    pub fn spawn_with_stdout(&self, args: &[&str], stdout: Stdio) -> Child {
         Command::new(env!("CARGO_BIN_EXE_zeroset"))
             .args(args)
             .arg("--config")
             .arg(&self.station_file)
             .current_dir(repo())
-            .stdout(Stdio::piped())
+            .stdout(stdout)
             .stderr(Stdio::piped())
             .spawn()
             .expect("zeroset starts")

@@ -90,8 +90,11 @@ fn with_stdout_closed(
     args: &[&str],
     meanwhile: impl FnOnce(),
 ) -> (Option<i32>, String) {
-    let mut child = station.spawn(args);
-    drop(child.stdout.take());
+    // The reading end is closed before the command starts: closing it after the spawn would race a quick
+    // command that had already written all it had into the pipe's buffer and exited 0.
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let child = station.spawn_with_stdout(args, writer.into());
     meanwhile();
     let output = child.wait_with_output().expect("it ends");
     (
