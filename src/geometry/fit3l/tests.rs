@@ -486,7 +486,7 @@ fn exact_distances_of_scattered_points_within_5_mm_are_the_global_minima() {
                 foot.point
             );
             assert_global_minimum(model, p, got);
-        } else if !(got - reference <= worst.0) {
+        } else if got - reference > worst.0 {
             worst = (got - reference, *p);
         }
     }
