@@ -47,15 +47,22 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         p: &SVector<f64, N>,
         previous: Option<(&SVector<f64, N>, &Foot<N>)>,
     ) -> Result<Foot<N>, DistanceError> {
+        // The fast path's foot is trusted at once only after a step within one sampling cell: across a longer
+        // step its checks say little (a point 1.9 mm inside a degree-8 section got a foot 3.7 mm away that way,
+        // in a batch of unordered points), so the seeded search decides, and the foot is kept only for when the
+        // search finds none.
+        let mut unconfirmed = None;
         if let Some((prev_point, prev_foot)) = previous {
             if let Some(foot) = self.along_the_scan(p, prev_point, prev_foot) {
-                return Ok(foot);
+                if (p - prev_point).norm() <= self.samples.cell_size() {
+                    return Ok(foot);
+                }
+                unconfirmed = Some(foot);
             }
         }
-        let (nearest_sample, _) = self
-            .samples
-            .nearest(p)
-            .ok_or(DistanceError::NoZeroSetNearby)?;
+        let Some((nearest_sample, _)) = self.samples.nearest(p) else {
+            return unconfirmed.ok_or(DistanceError::NoZeroSetNearby);
+        };
         // The point's own projection along the gradient: a point of the zero set that finds detail finer than the
         // sampling grid (a spurious sliver hugging a sharp edge), which no grid sample can.
         let own = project_to_zero_set(self.f, p, f64::INFINITY);
@@ -88,7 +95,7 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
                 }
             }
         }
-        match best {
+        match best.or(unconfirmed) {
             Some(foot) => Ok(foot),
             None => self.robust_fallback(p, &nearest_sample),
         }
@@ -122,13 +129,7 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         prev_point: &SVector<f64, N>,
         prev_foot: &Foot<N>,
     ) -> Option<Foot<N>> {
-        // The checks below speak for a neighbour only: across a step longer than the sampling cell the
-        // Lipschitz bound says nothing, and a local foot of a far point can pass the other two by coincidence (a
-        // point 1.9 mm inside a degree-8 section got a foot 3.7 mm away that way, in a batch of unordered points).
         let step = (p - prev_point).norm();
-        if step > self.samples.cell_size() {
-            return None;
-        }
         let (side, gradient) = self.f.value_gradient(p);
         let taubin = side / gradient.norm();
         let start = prev_foot.point + (p - prev_point);
