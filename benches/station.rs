@@ -111,6 +111,8 @@ fn now_us() -> u64 {
 struct Latencies {
     /// To its first deviation event: the preview, or the point itself where it came at once.
     first: Vec<u64>,
+    /// The same, with when each point arrived (unix us), in the order published.
+    first_at: Vec<(u64, u64)>,
     /// To its point event, which waits for the compensation's look-ahead.
     measured: Vec<u64>,
 }
@@ -143,9 +145,9 @@ fn inspect(station: &Station, serial: &str) -> (Latencies, Duration) {
                 received_unix_us,
                 ..
             } => {
-                latencies
-                    .first
-                    .push(arrived.saturating_sub(received_unix_us));
+                let latency = arrived.saturating_sub(received_unix_us);
+                latencies.first.push(latency);
+                latencies.first_at.push((received_unix_us, latency));
                 previewed.insert((scan.instance, scan.profile, index));
             }
             Event::Point {
@@ -158,6 +160,7 @@ fn inspect(station: &Station, serial: &str) -> (Latencies, Duration) {
                 latencies.measured.push(latency);
                 if !previewed.remove(&(scan.instance, scan.profile, index)) {
                     latencies.first.push(latency);
+                    latencies.first_at.push((received_unix_us, latency));
                 }
             }
             Event::JobFinished { .. } => return (latencies, started.elapsed()),
@@ -202,6 +205,38 @@ fn poll_status(socket: PathBuf, stop: std::sync::Arc<std::sync::atomic::AtomicBo
         std::thread::sleep(Duration::from_millis(5));
     }
     times
+}
+
+/// The first deviation event's latency by a point's place in its burst: the points that came off the line within
+/// 2 ms of the burst's first (a machine's data line carries several).
+fn by_place_in_burst(first_at: &[(u64, u64)]) -> String {
+    let mut places: Vec<Vec<u64>> = Vec::new();
+    let mut burst_start = 0;
+    let mut place = 0;
+    for &(received, latency) in first_at {
+        if received > burst_start + 2_000 || received < burst_start {
+            burst_start = received;
+            place = 0;
+        }
+        if places.len() <= place {
+            places.push(Vec::new());
+        }
+        places[place].push(latency);
+        place += 1;
+    }
+    let mut text =
+        "first deviation event by place in the burst of points off the line:".to_string();
+    for (place, us) in places.iter_mut().enumerate() {
+        us.sort_unstable();
+        text += &format!(
+            "\n  {place}: {} points, p50 {} us, p99 {} us, max {} us",
+            us.len(),
+            percentile(us, 0.5),
+            percentile(us, 0.99),
+            us.last().unwrap()
+        );
+    }
+    text
 }
 
 fn percentile(sorted: &[u64], p: f64) -> u64 {
@@ -252,6 +287,7 @@ fn main() {
         zeroset::geometry::sweep::compensation::LOOK_AHEAD,
         spread(&mut latencies.measured)
     );
+    println!("{}", by_place_in_burst(&latencies.first_at));
     let p99 = percentile(&latencies.first, 0.99);
     assert!(
         p99 <= 1_000,
