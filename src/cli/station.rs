@@ -75,7 +75,9 @@ pub struct ReportArgs {
     #[arg(required_unless_present_any = ["trend", "export"])]
     pub serial: Option<String>,
     /// Per profile of each instance, over the last parts: the worst + and worst - deviations and the form (mm),
-    /// Cp and Cpk of those against the tolerance, and the individuals-chart signals; trend.html beside it.
+    /// Cp and Cpk of those against the tolerance, and the individuals-chart signals; per blade parameter (chord,
+    /// thicknesses, camber, chord angle, pitch, angular spacing) its deviation's mean and spread, and Cp and Cpk
+    /// against its tolerance; trend.html beside it.
     #[arg(long, conflicts_with = "serial")]
     pub trend: bool,
     /// The inspection history as CSV on standard output, for spreadsheets.
@@ -378,7 +380,10 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<()> {
 
 /// `--trend` and `--export`: read from the history's database directly (no daemon needed).
 fn history(args: &ReportArgs) -> anyhow::Result<()> {
-    use crate::report::{history_csv, trend, trend_text, write_trend_html, Store, STORE_FILE};
+    use crate::report::{
+        history_csv, parameter_trend, parameter_trend_text, trend, trend_text, write_trend_html,
+        Store, STORE_FILE,
+    };
     let config = StationConfig::load(&args.station.config)?;
     let store = Store::open(&config.folders.data.join(STORE_FILE))?;
     let history = store.profile_history(&args.part_type, args.last)?;
@@ -409,9 +414,13 @@ fn history(args: &ReportArgs) -> anyhow::Result<()> {
     )?;
     let rows = trend(&history, lower, upper);
     out!("{}", trend_text(&rows, lower, upper))?;
+    let parameters = parameter_trend(&store.parameter_history(&args.part_type, args.last)?);
+    if !parameters.is_empty() {
+        out!("{}", parameter_trend_text(&parameters))?;
+    }
     let folder = config.folders.reports.join(&args.part_type);
     std::fs::create_dir_all(&folder)
         .with_context(|| format!("cannot create {}", folder.display()))?;
-    let chart = write_trend_html(&folder, &args.part_type, &rows, lower, upper)?;
+    let chart = write_trend_html(&folder, &args.part_type, &rows, &parameters, lower, upper)?;
     outln!("trend report, open in a browser: {}", chart.display())
 }

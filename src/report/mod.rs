@@ -5,6 +5,7 @@
 mod export;
 mod html;
 mod individuals;
+mod parameter_trend;
 mod plots;
 mod qif;
 mod store;
@@ -23,8 +24,9 @@ use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::analysis::tolerances::Iso484Class;
 pub use export::history_csv;
 pub use html::{write_html, HTML_FILE};
+pub use parameter_trend::{parameter_trend, parameter_trend_text, ParameterTrendRow};
 pub use qif::{write_qif, QIF_FILE};
-pub use store::{ProfileRecord, Store, StoreError, STORE_FILE};
+pub use store::{ParameterRecord, ProfileRecord, Store, StoreError, STORE_FILE};
 pub use summary::summary_text;
 pub use trend::{trend, trend_text, TrendRow};
 pub use trend_html::{write_trend_html, TREND_FILE};

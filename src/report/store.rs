@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use rusqlite::{params, Connection, OptionalExtension, Transaction};
 
 use super::PartReport;
+use crate::analysis::section::ParameterValue;
 use crate::analysis::stats::{DeviationStats, Verdict};
+use crate::analysis::tolerances::{Parameter, ParameterVerdict};
 
 /// The store's file in the data folder.
 pub const STORE_FILE: &str = "history.sqlite";
@@ -75,6 +77,23 @@ const MIGRATIONS: &[&str] = &[
     );
     CREATE INDEX rescans_by_profile ON rescans(inspection, instance, profile);
 "#,
+    // The blade parameters: a section's (instance and profile named), a blade's (profile '') and the part's
+    // (instance and profile ''), by the report's key; the limits on the deviation where toleranced.
+    r#"
+    CREATE TABLE parameters (
+        inspection  INTEGER NOT NULL REFERENCES inspections(id) ON DELETE CASCADE,
+        instance    TEXT NOT NULL,
+        profile     TEXT NOT NULL,
+        parameter   TEXT NOT NULL,
+        nominal     REAL NOT NULL,
+        measured    REAL NOT NULL,
+        deviation   REAL NOT NULL,
+        lower       REAL,
+        upper       REAL,
+        passed      INTEGER,
+        PRIMARY KEY (inspection, instance, profile, parameter)
+    );
+"#,
 ];
 
 /// The history database.
@@ -109,6 +128,25 @@ pub struct ProfileRecord {
     /// The inspection's tolerance band, mm.
     pub lower_mm: f64,
     pub upper_mm: f64,
+}
+
+/// One parameter of one inspection, as the history holds it: a section's, a blade's (`profile` empty) or the
+/// part's (`instance` and `profile` empty).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterRecord {
+    pub serial: String,
+    pub finished: String,
+    pub instance: String,
+    pub profile: String,
+    /// The report's key, its unit last (`chord_mm`, `chord_angle_deg`).
+    pub parameter: String,
+    pub nominal: f64,
+    pub measured: f64,
+    /// Measured minus nominal.
+    pub deviation: f64,
+    /// The limits the deviation was held to (lower, upper), where the part gave the parameter a tolerance.
+    pub limits: Option<(f64, f64)>,
+    pub passed: Option<bool>,
 }
 
 impl Store {
@@ -215,6 +253,45 @@ impl Store {
             .map_err(|e| self.error(e))?;
         rows.collect::<Result<_, _>>().map_err(|e| self.error(e))
     }
+
+    /// Every parameter of the last `last` inspections of a part type, oldest inspection first, then by instance,
+    /// profile and in the order the report lists them. Inspections entered before parameters were kept have none.
+    pub fn parameter_history(
+        &self,
+        part_type: &str,
+        last: usize,
+    ) -> Result<Vec<ParameterRecord>, StoreError> {
+        let mut statement = self
+            .connection
+            .prepare(
+                "SELECT i.serial, i.finished, p.instance, p.profile, p.parameter, p.nominal, p.measured,
+                        p.deviation, p.lower, p.upper, p.passed
+                 FROM parameters p JOIN inspections i ON i.id = p.inspection
+                 WHERE i.id IN (SELECT id FROM inspections WHERE part_type = ?1
+                                ORDER BY finished DESC, id DESC LIMIT ?2)
+                 ORDER BY i.finished, i.id, p.rowid",
+            )
+            .map_err(|e| self.error(e))?;
+        let rows = statement
+            .query_map(params![part_type, last as i64], |row| {
+                let lower: Option<f64> = row.get(8)?;
+                let upper: Option<f64> = row.get(9)?;
+                Ok(ParameterRecord {
+                    serial: row.get(0)?,
+                    finished: row.get(1)?,
+                    instance: row.get(2)?,
+                    profile: row.get(3)?,
+                    parameter: row.get(4)?,
+                    nominal: row.get(5)?,
+                    measured: row.get(6)?,
+                    deviation: row.get(7)?,
+                    limits: lower.zip(upper),
+                    passed: row.get(10)?,
+                })
+            })
+            .map_err(|e| self.error(e))?;
+        rows.collect::<Result<_, _>>().map_err(|e| self.error(e))
+    }
 }
 
 fn enter(tx: &Transaction, report: &PartReport, report_dir: &Path) -> rusqlite::Result<()> {
@@ -271,8 +348,52 @@ fn enter(tx: &Transaction, report: &PartReport, report_dir: &Path) -> rusqlite::
                 &profile.stats,
                 &profile.verdict,
             )?;
+            for (parameter, value) in profile.parameters.iter().flat_map(|p| p.judged()) {
+                let place = (instance.name.as_str(), profile.name.as_str());
+                insert_parameter(tx, inspection, place, parameter, value)?;
+            }
+        }
+        let blade = [
+            (Parameter::BladePitch, &instance.blade_pitch_mm),
+            (Parameter::AngularSpacing, &instance.angular_spacing_deg),
+        ];
+        for (parameter, value) in blade {
+            if let Some(value) = value {
+                insert_parameter(tx, inspection, (&instance.name, ""), parameter, value)?;
+            }
         }
     }
+    if let Some(pitch) = &report.propeller_pitch_mm {
+        insert_parameter(tx, inspection, ("", ""), Parameter::PropellerPitch, pitch)?;
+    }
+    Ok(())
+}
+
+/// `place` is (instance, profile), either empty where the parameter is a blade's or the part's.
+fn insert_parameter(
+    tx: &Transaction,
+    inspection: i64,
+    (instance, profile): (&str, &str),
+    parameter: Parameter,
+    value: &ParameterValue,
+) -> rusqlite::Result<()> {
+    tx.execute(
+        "INSERT INTO parameters (inspection, instance, profile, parameter, nominal, measured, deviation, lower,
+                                 upper, passed)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
+        params![
+            inspection,
+            instance,
+            profile,
+            parameter.key(),
+            value.nominal,
+            value.measured,
+            value.deviation,
+            value.tolerance.map(|t| t.lower),
+            value.tolerance.map(|t| t.upper),
+            value.verdict.map(|v| v == ParameterVerdict::Pass),
+        ],
+    )?;
     Ok(())
 }
 

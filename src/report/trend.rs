@@ -158,12 +158,12 @@ fn extreme(values: &[f64], room: impl Fn(f64) -> f64) -> Extreme {
     }
 }
 
-fn mean(values: &[f64]) -> f64 {
+pub(super) fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len() as f64
 }
 
 /// The sample (n - 1) standard deviation; 0 for one value.
-fn sample_deviation(values: &[f64], mean: f64) -> f64 {
+pub(super) fn sample_deviation(values: &[f64], mean: f64) -> f64 {
     if values.len() < 2 {
         return 0.0;
     }

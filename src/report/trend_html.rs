@@ -1,12 +1,13 @@
 //! trend.html: the trend of a part type over its inspected parts, for a quality engineer's browser. What is
-//! computed, stated on the page; a table of every profile's extremes, form and capability; per profile its trend
-//! chart and a table of its parts by serial and date. Self-contained (inline CSS and SVG, no scripts).
+//! computed, stated on the page; a table of every profile's extremes, form and capability; a table of every blade
+//! parameter's spread and capability; per profile its trend chart and a table of its parts by serial and date. Self-contained (inline CSS and SVG, no scripts).
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 use super::html::{escape, STYLE};
 use super::individuals::RUN_LENGTH;
+use super::parameter_trend::ParameterTrendRow;
 use super::summary::deviation;
 use super::trend::{TrendRow, FEW_PARTS};
 use super::trend_chart::trend_svg;
@@ -25,11 +26,12 @@ pub fn write_trend_html(
     dir: &Path,
     part_type: &str,
     rows: &[TrendRow],
+    parameters: &[ParameterTrendRow],
     lower_mm: f64,
     upper_mm: f64,
 ) -> std::io::Result<PathBuf> {
     let path = dir.join(TREND_FILE);
-    let html = trend_page(part_type, rows, lower_mm, upper_mm)
+    let html = trend_page(part_type, rows, parameters, lower_mm, upper_mm)
         .map_err(|e| std::io::Error::other(format!("cannot write {}: {e}", path.display())))?;
     write_atomically(&path, html.as_bytes())?;
     Ok(path)
@@ -38,6 +40,7 @@ pub fn write_trend_html(
 fn trend_page(
     part_type: &str,
     rows: &[TrendRow],
+    parameters: &[ParameterTrendRow],
     lower_mm: f64,
     upper_mm: f64,
 ) -> Result<String, String> {
@@ -49,6 +52,9 @@ fn trend_page(
     page.push_str(&header(part_type, rows, lower_mm, upper_mm));
     page.push_str(&definitions(lower_mm, upper_mm));
     page.push_str(&profile_table(rows));
+    if !parameters.is_empty() {
+        page.push_str(&parameter_table(parameters));
+    }
     for row in rows {
         write!(
             page,
@@ -170,6 +176,51 @@ fn profile_table(rows: &[TrendRow]) -> String {
         ] {
             write!(html, "<td>{value}</td>").expect("writing to a String");
         }
+        for index in [row.cp, row.cpk] {
+            html.push_str(&match index {
+                Some(v) => cell(format!("{v:.2}"), v < CAPABLE),
+                None => "<td>-</td>".to_string(),
+            });
+        }
+        writeln!(
+            html,
+            "{}</tr>",
+            cell(row.signalled().to_string(), row.signalled() > 0)
+        )
+        .expect("writing to a String");
+    }
+    html.push_str("</table>\n");
+    html
+}
+
+/// One row per blade parameter: the spread of its deviation from nominal over the parts and its capability.
+fn parameter_table(rows: &[ParameterTrendRow]) -> String {
+    let mut html = String::from(
+        "<h2>Blade parameters</h2>\n<p>Per part the parameter's deviation from nominal (measured minus nominal, in \
+         the parameter's unit); over the parts x&#772; its mean and s its sample standard deviation (n - 1). On \
+         the newest inspection's tolerance [LSL, USL] of the deviation: <b>Cp</b> = (USL - LSL) / 6 s, <b>Cpk</b> \
+         = min(USL - x&#772;, x&#772; - LSL) / 3 s. Control signals as for the profiles, on the deviation.</p>\n\
+         <table>\n<tr><th>where</th><th>parameter</th><th>parts</th><th>failed</th><th>mean</th><th>s</th>\
+         <th>tolerance</th><th>Cp</th><th>Cpk</th><th>control signals</th></tr>\n",
+    );
+    for row in rows {
+        let unit = row.unit();
+        let tolerance = row.limits.map_or("-".to_string(), |(lower, upper)| {
+            format!("{lower:+.4} .. {upper:+.4} {unit}")
+        });
+        write!(
+            html,
+            "<tr><td class=\"name\">{}</td><td class=\"name\">{}</td><td>{}</td>{}<td>{:+.4} {unit}</td>\
+             <td>{:.4} {unit}</td><td>{}</td>",
+            escape(&row.place()),
+            escape(&row.parameter),
+            row.parts.len(),
+            cell(row.failed().to_string(), row.failed() > 0),
+            row.mean,
+            row.spread,
+            escape(&tolerance)
+        )
+        .expect("writing to a String");
         for index in [row.cp, row.cpk] {
             html.push_str(&match index {
                 Some(v) => cell(format!("{v:.2}"), v < CAPABLE),

@@ -554,9 +554,50 @@ fn the_trend_of_a_failing_blade_is_not_capable_and_renders_in_a_browser() {
         cp < 1.0 && cpk < 1.0,
         "Cp {cp}, Cpk {cpk} of a failing profile: {row}"
     );
+    // B r100's local pitch over the three parts: their mean deviation, and Cp, Cpk on its class S tolerance.
+    let pitches: Vec<_> = serials
+        .iter()
+        .map(|serial| {
+            let (_, report) = station.report(serial);
+            let parameters = report.instances[1].profiles[0].parameters;
+            parameters.and_then(|p| p.pitch_mm).expect("B r100's pitch")
+        })
+        .collect();
+    let mean = pitches.iter().map(|p| p.deviation).sum::<f64>() / 3.0;
+    let row = trend
+        .lines()
+        .find(|l| l.starts_with("B r100 ") && l.contains(" pitch_mm "))
+        .unwrap_or_else(|| panic!("no parameter row of B r100's pitch in\n{trend}"));
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    let limits = pitches[2].tolerance.expect("class S holds the local pitch");
+    assert_eq!(cells[3], "3", "{row}");
+    assert_eq!(cells[5], format!("{mean:+.4}"), "{row}");
+    assert_eq!(
+        cells[7..10],
+        [
+            format!("{:+.4}", limits.lower).as_str(),
+            "..",
+            format!("{:+.4}", limits.upper).as_str()
+        ],
+        "{row}"
+    );
+    assert!(
+        cells[11].parse::<f64>().is_ok(),
+        "a Cp of three parts: {row}"
+    );
+    assert!(
+        trend
+            .lines()
+            .any(|l| l.starts_with("B (blade) ") && l.contains(" blade_pitch_mm ")),
+        "{trend}"
+    );
     let page = trend_page(&trend);
     let html = std::fs::read_to_string(&page).expect("trend.html");
     assert!(!html.contains("<pre"), "no preformatted dump");
+    assert!(
+        html.contains("<h2>Blade parameters</h2>"),
+        "the parameters' table"
+    );
     assert!(
         html.contains(&format!("{:+.4}", b100.stats.max_mm)),
         "SN-T3's worst + of B r100 in a table"
@@ -564,9 +605,10 @@ fn the_trend_of_a_failing_blade_is_not_capable_and_renders_in_a_browser() {
     let Some(dom) = render_in_a_browser(&page) else {
         return;
     };
-    // As the browser built it: the profile table and one parts table per profile; a chart per profile, each
-    // with every part's serial and date on its abscissa, control limits, and red marks outside the band.
-    assert_eq!(dom.matches("<table>").count(), 1 + 15, "tables");
+    // As the browser built it: the profile table, the parameters' table and one parts table per profile; a chart
+    // per profile, each with every part's serial and date on its abscissa, control limits, and red marks outside
+    // the band.
+    assert_eq!(dom.matches("<table>").count(), 2 + 15, "tables");
     assert_eq!(dom.matches("<svg").count(), 15, "charts");
     let b100_chart = dom
         .split("<h2>")

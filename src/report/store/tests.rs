@@ -112,3 +112,52 @@ fn reopening_keeps_the_history_and_a_newer_schema_is_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn a_judged_blades_parameters_are_kept_with_their_limits_and_verdicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut store = open(&dir);
+    let mut report = sample_report();
+    crate::report::tests::judge_a_sample_blade(&mut report);
+    store.record(&report, Path::new("/r/1")).unwrap();
+    // Entered again (a job finished twice), each parameter still counts once.
+    store.record(&report, Path::new("/r/1")).unwrap();
+    let history = store.parameter_history("propeller-3", 10).unwrap();
+    let keys: Vec<(&str, &str, &str)> = history
+        .iter()
+        .map(|r| {
+            (
+                r.instance.as_str(),
+                r.profile.as_str(),
+                r.parameter.as_str(),
+            )
+        })
+        .collect();
+    let section = |key| ("blade-B", "p100", key);
+    assert_eq!(
+        keys,
+        [
+            section("chord_mm"),
+            section("max_thickness_mm"),
+            section("le_thickness_mm"),
+            section("te_thickness_mm"),
+            section("max_camber_mm"),
+            section("chord_angle_deg"),
+            section("le_radius_mm"),
+            section("pitch_mm"),
+            ("blade-B", "", "blade_pitch_mm"),
+        ]
+    );
+    let thickness = &history[1];
+    assert_eq!((thickness.nominal, thickness.measured), (20.7383, 20.7001));
+    assert!((thickness.deviation + 0.0382).abs() < 1e-12);
+    assert_eq!(
+        (thickness.limits, thickness.passed),
+        (Some((-0.03, 0.03)), Some(false))
+    );
+    let blade = &history[8];
+    assert_eq!(blade.passed, Some(false));
+    assert!((blade.limits.unwrap().1 - 9.0).abs() < 1e-12, "{blade:?}");
+    // No ISO 484 class tolerances an edge radius: no limits, no verdict.
+    assert_eq!((history[6].limits, history[6].passed), (None, None));
+}

@@ -2,7 +2,8 @@ use quick_xml::events::Event;
 
 use super::*;
 use crate::report::html::tests::svgs;
-use crate::report::store::ProfileRecord;
+use crate::report::parameter_trend::parameter_trend;
+use crate::report::store::{ParameterRecord, ProfileRecord};
 use crate::report::trend::trend;
 
 const LOWER: f64 = -0.1;
@@ -46,7 +47,7 @@ fn history() -> Vec<ProfileRecord> {
 
 fn page() -> (Vec<TrendRow>, String) {
     let rows = trend(&history(), LOWER, UPPER);
-    let html = trend_page("propeller", &rows, LOWER, UPPER).unwrap();
+    let html = trend_page("propeller", &rows, &[], LOWER, UPPER).unwrap();
     (rows, html)
 }
 
@@ -242,4 +243,51 @@ fn control_limits_need_two_parts_and_long_histories_label_every_kth_part() {
         .filter(|k| svg.contains(&format!(">\nSN-{k}  ")))
         .collect();
     assert_eq!(labelled, (1..=60).step_by(3).collect::<Vec<_>>());
+}
+
+#[test]
+fn blade_parameters_get_a_table_of_their_capability_after_the_profiles() {
+    // B r100's chord over the twelve parts: +0.01 mm but for part 12, 0.09 mm long (outside -0.05 .. +0.05 mm).
+    let parameters: Vec<ParameterRecord> = (0..PARTS)
+        .map(|k| {
+            let deviation = if k == PARTS - 1 { 0.09 } else { 0.01 };
+            ParameterRecord {
+                serial: format!("SN-{}", k + 1),
+                finished: format!("2026-11-{:02}T08:30:00Z", k + 1),
+                instance: "B".into(),
+                profile: "r100".into(),
+                parameter: "chord_mm".into(),
+                nominal: 172.85,
+                measured: 172.85 + deviation,
+                deviation,
+                limits: Some((-0.05, 0.05)),
+                passed: Some(deviation <= 0.05),
+            }
+        })
+        .collect();
+    let parameter_rows = parameter_trend(&parameters);
+    let rows = trend(&history(), LOWER, UPPER);
+    let html = trend_page("propeller", &rows, &parameter_rows, LOWER, UPPER).unwrap();
+    let tables = tables(&html);
+    assert_eq!(tables.len(), 2 + rows.len());
+    let chord = &tables[1][0];
+    // Mean 0.0166667 mm, s = 0.08 / sqrt(12) = 0.0230940: Cp = 0.1 / 0.138564 = 0.72, Cpk = 0.0333 / 0.069282
+    // = 0.48, both failing; part 12 breaks the control limit (centre + 2.66 x 0.08 / 11 = 0.0360 mm) and parts 8
+    // to 11 the run rule (the eleven before it all below the centre): five parts signalled.
+    assert_eq!(
+        texts(chord),
+        [
+            "B r100",
+            "chord_mm",
+            "12",
+            "1",
+            "+0.0167 mm",
+            "0.0231 mm",
+            "-0.0500 .. +0.0500 mm",
+            "0.72",
+            "0.48",
+            "5"
+        ]
+    );
+    assert!(chord[3].failing && chord[7].failing && chord[8].failing && chord[9].failing);
 }
