@@ -9,6 +9,7 @@ use quick_xml::Writer;
 
 use super::elements::{counted, decimal, reference, references, text, with_id, Xml};
 use super::ids::{scans, DocumentIds, ProfileIds};
+use super::parameters::{self, parameter_characteristics};
 use super::qpid::inspection_qpid;
 use super::results::results;
 use super::FORM_VALUE_MEANING;
@@ -53,7 +54,9 @@ fn header(xml: &mut Xml, report: &PartReport) -> io::Result<()> {
     let description = format!(
         "zeroset inspection of part {} serial {} (job {}, {} to {}). Lengths in mm. {FORM_VALUE_MEANING} \
          Measured points are probe-compensated surface points in machine coordinates (mm) with their signed \
-         deviations ({}; {}); each profile is the section x = const of the part's frame.",
+         deviations ({}; {}); each profile is the section x = const of the part's frame. Blade parameters are \
+         length, thickness, radius and angle characteristics (angles in degrees) whose TargetValue is the master's \
+         value and whose tolerance is on the deviation from it; NOT_ANALYZED marks one without a tolerance.",
         report.part,
         report.serial,
         report.job,
@@ -91,6 +94,16 @@ fn file_units(xml: &mut Xml) -> io::Result<()> {
     xml.create_element("FileUnits").write_inner_content(|xml| {
         xml.create_element("PrimaryUnits")
             .write_inner_content(|xml| {
+                xml.create_element("AngularUnit")
+                    .write_inner_content(|xml| {
+                        text(xml, "SIUnitName", "radian")?;
+                        text(xml, "UnitName", "degree")?;
+                        xml.create_element("UnitConversion")
+                            .write_inner_content(|xml| {
+                                decimal(xml, "Factor", std::f64::consts::PI / 180.0)
+                            })?;
+                        Ok(())
+                    })?;
                 xml.create_element("LinearUnit")
                     .write_inner_content(|xml| {
                         text(xml, "SIUnitName", "meter")?;
@@ -187,9 +200,11 @@ fn determined_by_measurement(xml: &mut Xml) -> io::Result<()> {
     Ok(())
 }
 
-/// One line-profile characteristic (definition with the tolerance zone, nominal, item) per profile and instance.
+/// One line-profile characteristic (definition with the tolerance zone, nominal, item) per profile and instance,
+/// then one per blade parameter.
 fn characteristics(xml: &mut Xml, report: &PartReport, ids: &DocumentIds) -> io::Result<()> {
-    let count = ids.profiles.len();
+    let blade_parameters = parameter_characteristics(report);
+    let count = ids.profiles.len() + blade_parameters.len();
     xml.create_element("Characteristics")
         .write_inner_content(|xml| {
             reference(xml, "FormalStandardId", ids.standard)?;
@@ -197,6 +212,9 @@ fn characteristics(xml: &mut Xml, report: &PartReport, ids: &DocumentIds) -> io:
                 for ((instance, profile), profile_ids) in scans(report).zip(&ids.profiles) {
                     let name = scan_name(instance, profile);
                     line_profile_definition(xml, &name, &report.tolerance, profile_ids)?;
+                }
+                for (parameter, own) in blade_parameters.iter().zip(&ids.parameters) {
+                    parameters::definition(xml, parameter, own.definition)?;
                 }
                 Ok(())
             })?;
@@ -218,6 +236,9 @@ fn characteristics(xml: &mut Xml, report: &PartReport, ids: &DocumentIds) -> io:
                         text(xml, "Vector", PROFILE_PLANE_NORMAL)
                     })?;
                 }
+                for (k, parameter) in blade_parameters.iter().enumerate() {
+                    parameters::nominal(xml, parameter, ids, k)?;
+                }
                 Ok(())
             })?;
             counted(xml, "CharacteristicItems", count).write_inner_content(|xml| {
@@ -237,6 +258,9 @@ fn characteristics(xml: &mut Xml, report: &PartReport, ids: &DocumentIds) -> io:
                             profile_ids.characteristic_nominal,
                         )
                     })?;
+                }
+                for (k, parameter) in blade_parameters.iter().enumerate() {
+                    parameters::item(xml, report, parameter, ids, k)?;
                 }
                 Ok(())
             })?;

@@ -2,6 +2,7 @@
 //! an element of the right kind; assigning them all up front, in one place, keeps the writer from inventing or
 //! reusing one, and gives the document its `idMax`.
 
+use super::parameters::parameter_characteristics;
 use crate::report::{InstanceReport, PartReport, ProfileReport};
 
 /// The ids of everything one scanned profile of one instance contributes.
@@ -17,6 +18,15 @@ pub(super) struct ProfileIds {
     pub characteristic_measurement: u32,
 }
 
+/// The ids of one blade parameter's characteristic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct ParameterIds {
+    pub definition: u32,
+    pub nominal: u32,
+    pub item: u32,
+    pub measurement: u32,
+}
+
 /// Every id of the document, numbered from 1 in the order the elements are written.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(super) struct DocumentIds {
@@ -29,6 +39,8 @@ pub(super) struct DocumentIds {
     pub devices: Vec<(String, u32)>,
     /// One per profile, in [`scans`] order.
     pub profiles: Vec<ProfileIds>,
+    /// One per blade parameter, in [`parameter_characteristics`] order.
+    pub parameters: Vec<ParameterIds>,
     pub measurement_results: u32,
     pub actual_component: u32,
     /// The largest id, QIF's `idMax`.
@@ -73,6 +85,15 @@ impl DocumentIds {
                 characteristic_measurement: next(),
             })
             .collect();
+        let parameters = parameter_characteristics(report)
+            .iter()
+            .map(|_| ParameterIds {
+                definition: next(),
+                nominal: next(),
+                item: next(),
+                measurement: next(),
+            })
+            .collect();
         let measurement_results = next();
         let actual_component = next();
         DocumentIds {
@@ -81,6 +102,7 @@ impl DocumentIds {
             curve_definition,
             devices,
             profiles,
+            parameters,
             measurement_results,
             actual_component,
             max: last,

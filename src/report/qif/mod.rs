@@ -1,11 +1,15 @@
 //! report.qif: the part's inspection as a QIF 3.0 Results document (valid against QIFDocument.xsd), for plant
 //! systems that import QIF. Each profile of each instance is one line-profile characteristic with its tolerance
 //! zone, its measured point set, its form value, its worst deviations and its status; the actual component
-//! carries the part's serial number. Lengths are in mm.
+//! carries the part's serial number. Each blade parameter (a section's chord, thicknesses, edge radii, camber,
+//! chord angle and pitch; a blade's mean pitch and angular spacing; the propeller's mean pitch) is a length,
+//! thickness, radius or angle characteristic with its nominal, tolerance, value and status. Lengths are in mm,
+//! angles in degrees.
 
 mod document;
 mod elements;
 mod ids;
+mod parameters;
 mod qpid;
 mod results;
 

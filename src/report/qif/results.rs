@@ -7,6 +7,7 @@ use super::document::scan_name;
 use super::elements::{counted, decimal, numbers, reference, references, text, with_id, Xml};
 use super::form_value_mm;
 use super::ids::{scans, DocumentIds, ProfileIds};
+use super::parameters::{self, parameter_characteristics};
 use crate::analysis::stats::Verdict;
 use crate::report::{InstanceReport, PartReport, ProfileReport};
 
@@ -30,18 +31,22 @@ pub(super) fn results(xml: &mut Xml, report: &PartReport, ids: &DocumentIds) -> 
                         }
                         Ok(())
                     })?;
+                    let blade_parameters = parameter_characteristics(report);
+                    let characteristics = count + blade_parameters.len();
                     xml.create_element("MeasuredCharacteristics")
                         .write_inner_content(|xml| {
-                            counted(xml, "CharacteristicMeasurements", count).write_inner_content(
-                                |xml| {
+                            counted(xml, "CharacteristicMeasurements", characteristics)
+                                .write_inner_content(|xml| {
                                     for ((_, profile), profile_ids) in
                                         scans(report).zip(&ids.profiles)
                                     {
                                         line_profile_measurement(xml, profile, profile_ids, ids)?;
                                     }
+                                    for (k, parameter) in blade_parameters.iter().enumerate() {
+                                        parameters::measurement(xml, report, parameter, ids, k)?;
+                                    }
                                     Ok(())
-                                },
-                            )?;
+                                })?;
                             Ok(())
                         })?;
                     inspection_status(xml, "InspectionStatus", part_status)?;

@@ -352,7 +352,7 @@ fn the_numbers_agree_with_the_report_and_the_serial_is_there() {
         texts(&text, "FeatureName")[..4],
         ["A/r100", "A/r200", "B/r100", "B/r200"]
     );
-    assert_eq!(texts(&text, "UnitName"), ["mm"]);
+    assert_eq!(texts(&text, "UnitName"), ["degree", "mm"]);
     assert!(texts(&text, "Description")[0].contains("2 x max |deviation|"));
     assert!(text.contains("<!-- Each line-profile characteristic's measured Value is"));
 }
@@ -421,4 +421,79 @@ fn an_off_centre_zone_states_its_outer_boundary_and_a_profile_machine_missing_fr
         [1.5; 2],
         "unknown radius left out"
     );
+}
+
+/// The element `<{element} ...>...</{element}>` of the document whose text holds `<{child}>{value}</{child}>`.
+fn element_with<'a>(text: &'a str, element: &str, child: &str, value: &str) -> &'a str {
+    let (open, close) = (format!("<{element} "), format!("</{element}>"));
+    let wanted = format!("<{child}>{value}</{child}>");
+    text.match_indices(&open)
+        .map(|(start, _)| &text[start..start + text[start..].find(&close).unwrap() + close.len()])
+        .find(|found| found.contains(&wanted))
+        .unwrap_or_else(|| panic!("no {element} with {wanted} in\n{text}"))
+}
+
+/// The definition, nominal and measurement of the blade parameter named `name`, a QIF `kind` characteristic.
+fn parameter_elements<'a>(text: &'a str, kind: &str, name: &str) -> [&'a str; 3] {
+    let item = element_with(text, &format!("{kind}Item"), "Name", name);
+    let id = item.split('"').nth(1).unwrap();
+    [
+        element_with(text, &format!("{kind}Definition"), "Name", name),
+        element_with(text, &format!("{kind}Nominal"), "Name", name),
+        element_with(
+            text,
+            &format!("{kind}Measurement"),
+            "CharacteristicItemId",
+            id,
+        ),
+    ]
+}
+
+#[test]
+fn blade_parameters_are_characteristics_with_their_nominal_tolerance_value_and_status() {
+    let mut report = two_blade_report();
+    crate::report::tests::judge_a_sample_blade(&mut report);
+    report.propeller_pitch_mm = Some(crate::analysis::section::ParameterValue::of(900.0, 901.5));
+    let (dir, text) = written(&report);
+    assert_valid(dir.path());
+    // B/r100's maximum thickness: nominal 20.7383 mm, measured 20.7001 mm, held to +-0.03 mm: it fails.
+    let [definition, nominal, measurement] =
+        parameter_elements(&text, "ThicknessCharacteristic", "B/r100 max_thickness_mm");
+    assert_eq!(numbers_in(definition, "MaxValue"), [0.03]);
+    assert_eq!(numbers_in(definition, "MinValue"), [-0.03]);
+    assert_eq!(texts(definition, "DefinedAsLimit"), ["false"]);
+    assert_eq!(numbers_in(nominal, "TargetValue"), [20.7383]);
+    assert_eq!(numbers_in(measurement, "Value"), [20.7001]);
+    assert_eq!(texts(measurement, "CharacteristicStatusEnum"), ["FAIL"]);
+    let scanned_at = &report.instances[1].profiles[0].scanned_at;
+    assert_eq!(texts(measurement, "TimeStamp"), [scanned_at.as_str()]);
+    // Its chord is within class I: a passing length.
+    let [_, _, chord] = parameter_elements(&text, "LengthCharacteristic", "B/r100 chord_mm");
+    assert_eq!(texts(chord, "CharacteristicStatusEnum"), ["PASS"]);
+    // No class tolerances the chord angle or an edge radius: measured, not analysed.
+    let [definition, _, measurement] =
+        parameter_elements(&text, "AngleCharacteristic", "B/r100 chord_angle_deg");
+    assert_eq!(texts(definition, "NonTolerance"), ["MEASURED"]);
+    assert_eq!(numbers_in(measurement, "Value"), [55.0475]);
+    assert_eq!(
+        texts(measurement, "CharacteristicStatusEnum"),
+        ["NOT_ANALYZED"]
+    );
+    let [_, nominal, _] = parameter_elements(&text, "RadiusCharacteristic", "B/r100 le_radius_mm");
+    assert_eq!(numbers_in(nominal, "TargetValue"), [2.9214]);
+    // The blade's mean pitch, 1.2 % coarse against class I's +-1 % (+-9 mm), and the propeller's, untoleranced.
+    let [definition, _, measurement] =
+        parameter_elements(&text, "LengthCharacteristic", "B blade_pitch_mm");
+    assert_eq!(numbers_in(definition, "MaxValue"), [9.0]);
+    assert_eq!(texts(measurement, "CharacteristicStatusEnum"), ["FAIL"]);
+    assert!(
+        !measurement.contains("<TimeStamp>"),
+        "a blade's parameter has no one scan"
+    );
+    let [_, _, measurement] =
+        parameter_elements(&text, "LengthCharacteristic", "propeller_pitch_mm");
+    assert_eq!(numbers_in(measurement, "Value"), [901.5]);
+    // Four line profiles, eight parameters of B/r100, one of blade B, one of the propeller.
+    let counts = texts_and_attributes(&text, "", "CharacteristicMeasurements", "n").1;
+    assert_eq!(counts, ["14"]);
 }
