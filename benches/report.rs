@@ -45,6 +45,7 @@ fn profile(blade: usize, x: f64, shift: f64) -> ProfileReport {
                 off_plane_mm: 0.0,
                 quality: 0.0,
                 flagged: false,
+                after_fit_mm: None,
             }
         })
         .collect();

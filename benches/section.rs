@@ -44,7 +44,7 @@ fn section_evaluation(c: &mut Criterion) {
         .map(|p| p + Vector3::new(0.0, 0.0, 0.4))
         .collect();
     // A check that the bench times real work: the fit finds the 0.4 mm move.
-    let fits = best_fits(&gauge, &points).expect("best fits");
+    let fits = best_fits(&gauge, &points).expect("best fits").fits;
     eprintln!(
         "r300, {POINTS} points moved 0.4 mm along z: l2 shift ({:+.4}, {:+.4}) mm, minzone zone {:.4} mm",
         fits[0].shift_mm[0], fits[0].shift_mm[1], fits[1].form.zone_mm

@@ -57,12 +57,17 @@ pub struct SectionBestFit {
     pub form: SectionForm,
 }
 
+/// A section's best fits, and each of its points' deviation after the least-squares one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionFits {
+    pub fits: Vec<SectionBestFit>,
+    /// In the order of the points fitted, mm.
+    pub after_l2_mm: Vec<f64>,
+}
+
 /// The section's fits by least squares and by minimum zone, from its points (part frame, in scan order, flagged
 /// contacts left out); `Err` says why the section could not be fitted.
-pub fn best_fits(
-    gauge: &ProfileGauge,
-    points: &[Point3<f64>],
-) -> Result<Vec<SectionBestFit>, String> {
+pub fn best_fits(gauge: &ProfileGauge, points: &[Point3<f64>]) -> Result<SectionFits, String> {
     if points.len() < 4 {
         return Err(format!(
             "{} points are too few for a best fit",
@@ -94,13 +99,17 @@ pub fn best_fits(
             })
             .collect()
     };
-    [(FitMethod::L2, "l2"), (FitMethod::MinZone, "minzone")]
+    let mut after_l2_mm = Vec::new();
+    let fits = [(FitMethod::L2, "l2"), (FitMethod::MinZone, "minzone")]
         .into_iter()
         .map(|(method, name)| {
             let fitted = fit_section(&in_plane, pivot, chord, FitMode::Full, method, measure)
                 .map_err(|e| e.to_string())?;
             let across = Vector2::new(-chord.y, chord.x);
             let shift = chord * fitted.dchord_mm + across * fitted.dn_mm;
+            if method == FitMethod::L2 {
+                after_l2_mm = fitted.after_mm;
+            }
             Ok(SectionBestFit {
                 mode: "full".into(),
                 method: name.into(),
@@ -112,7 +121,8 @@ pub fn best_fits(
                 form: form(&fitted.form),
             })
         })
-        .collect()
+        .collect::<Result<_, String>>()?;
+    Ok(SectionFits { fits, after_l2_mm })
 }
 
 fn form(form: &Form) -> SectionForm {

@@ -4,7 +4,9 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use super::plots::{deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures};
+use super::plots::{
+    after_best_fit, deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures,
+};
 use super::summary::{
     deviation, machine_text, parameter_failures, parameter_tolerances_text, COORDINATE_DECIMALS,
     DEVIATION_DECIMALS,
@@ -391,6 +393,20 @@ fn profile_figures_html(
         whisker_svg(figures.name, &figures.sections)?,
     ] {
         writeln!(html, "<figure>\n{svg}\n</figure>").expect("writing to a String");
+    }
+    if let Some(fitted) = after_best_fit(&figures.sections) {
+        let name = format!(
+            "{} after the best fit (shift and twist removed)",
+            figures.name
+        );
+        writeln!(
+            html,
+            "<figure>\n{}\n<figcaption>{}: each point's deviation once its section's least-squares best fit \
+             (the shifts and twist in the best-fit table) is removed, its form error.</figcaption>\n</figure>",
+            whisker_svg(&name, &fitted)?,
+            escape(figures.name)
+        )
+        .expect("writing to a String");
     }
     Ok(html)
 }

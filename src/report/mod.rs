@@ -169,6 +169,11 @@ pub struct PointRecord {
     /// is kept but left out of the statistics and the verdict. Absent (false) in older reports.
     #[serde(default)]
     pub flagged: bool,
+    /// The deviation once the section's least-squares best fit (its shift and twist) is removed, mm: its form
+    /// error at this point. Absent for flagged points, where the section could not be fitted, and in older
+    /// reports.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub after_fit_mm: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -66,6 +66,33 @@ fn add_scan<'a>(
     }
 }
 
+/// The sections as they lie after their least-squares best fits: each point's deviation the one once the
+/// section's shift and twist are removed (its form error; 0, drawn as no whisker, where a point has none).
+/// `None` when no point has one (older reports, sections that could not be fitted).
+pub fn after_best_fit<'a>(sections: &[InstanceSection<'a>]) -> Option<Vec<InstanceSection<'a>>> {
+    let fitted = sections
+        .iter()
+        .flat_map(|s| &s.points)
+        .any(|p| p.after_fit_mm.is_some());
+    fitted.then(|| {
+        sections
+            .iter()
+            .map(|section| InstanceSection {
+                instance: section.instance,
+                colour: section.colour,
+                points: section
+                    .points
+                    .iter()
+                    .map(|p| SectionPoint {
+                        deviation_mm: p.after_fit_mm.unwrap_or(0.0),
+                        ..*p
+                    })
+                    .collect(),
+            })
+            .collect()
+    })
+}
+
 /// Okabe and Ito's colour-blind-safe palette (without its yellow, too pale on white), repeated past seven.
 const INSTANCE_COLOURS: [RGBColor; 7] = [
     RGBColor(0, 114, 178),

@@ -37,6 +37,7 @@ fn profile(
                 off_plane_mm: 0.002 * t,
                 quality: 1.0,
                 flagged: false,
+                after_fit_mm: None,
             }
         })
         .collect();

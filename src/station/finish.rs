@@ -240,6 +240,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     off_plane_mm: measured.off_plane_mm,
                     quality: raw.quality,
                     flagged: point.is_flagged(),
+                    after_fit_mm: None,
                 });
             }
             if flagged > 0 {
@@ -253,11 +254,19 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let summary = stats
                 .summary()
                 .ok_or_else(|| format!("{}: the scan has no points", plan.describe(key)))?;
-            let best_fits = section::best_fits(&inputs.gauges[key.profile], &in_part)
-                .unwrap_or_else(|problem| {
+            let best_fits = match section::best_fits(&inputs.gauges[key.profile], &in_part) {
+                Ok(fitted) => {
+                    let unflagged = points.iter_mut().filter(|p| !p.flagged);
+                    for (point, after) in unflagged.zip(fitted.after_l2_mm) {
+                        point.after_fit_mm = Some(after);
+                    }
+                    fitted.fits
+                }
+                Err(problem) => {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no best fit of the section");
                     Vec::new()
-                });
+                }
+            };
             let parameters = inputs.gauges[key.profile]
                 .nominal_parameters()
                 .map_err(str::to_string)

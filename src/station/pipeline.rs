@@ -239,10 +239,12 @@ impl Pipeline {
         let described = self.plan.describe(key);
         tokio::task::spawn_blocking(move || {
             let gauge = &gauges[key.profile];
-            let best_fits = section::best_fits(gauge, &in_part).unwrap_or_else(|problem| {
-                tracing::warn!(scan = %described, %problem, "live: no best fit of the section");
-                Vec::new()
-            });
+            let best_fits = section::best_fits(gauge, &in_part)
+                .map(|f| f.fits)
+                .unwrap_or_else(|problem| {
+                    tracing::warn!(scan = %described, %problem, "live: no best fit of the section");
+                    Vec::new()
+                });
             let parameters = gauge
                 .nominal_parameters()
                 .map_err(str::to_string)

@@ -384,8 +384,9 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     if let Some(dom) = render_in_a_browser(&dir.join("report.html")) {
         assert_eq!(
             dom.matches("<svg").count(),
-            2 * 5,
-            "a deviation and a whisker plot per profile in the rendered page"
+            3 * 5,
+            "per profile in the rendered page: a deviation plot, and whisker plots as measured and after the \
+             best fit"
         );
     }
     // The same numbers in every report of the inspection.
@@ -393,8 +394,8 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert_eq!(
         html.matches("<svg").count(),
-        2 * 5,
-        "a deviation and a whisker plot per profile"
+        3 * 5,
+        "a deviation plot and two whisker plots (as measured, after the best fit) per profile"
     );
     assert!(
         html.contains(&format!("{:+.4}", b300.stats.mean_mm)),
@@ -473,6 +474,28 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         "{row}"
     );
     assert!(b100.best_fits[0].dn_mm < -0.2, "below: {row}");
+    // Each point keeps its deviation after that fit: B r100's 0.4 mm move is gone from them, and they span the
+    // fit's form.
+    let after: Vec<f64> = b100
+        .points
+        .iter()
+        .filter(|p| !p.flagged)
+        .map(|p| p.after_fit_mm.expect("a deviation after the fit"))
+        .collect();
+    let form = &b100.best_fits[0].form;
+    let (lowest, highest) = after
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &a| {
+            (lo.min(a), hi.max(a))
+        });
+    assert_eq!((lowest, highest), (form.min_mm, form.max_mm));
+    let rms = (after.iter().map(|a| a * a).sum::<f64>() / after.len() as f64).sqrt();
+    assert!((rms - form.rms_mm).abs() < 1e-9, "{rms} against {form:?}");
+    assert!(
+        form.rms_mm < b100.stats.rms_mm / 10.0,
+        "the move removed: {form:?}, before {:?}",
+        b100.stats
+    );
     let thickness = b100.parameters.as_ref().unwrap().max_thickness_mm.deviation;
     assert_eq!(cells[7], format!("{thickness:+.4}"), "{row}");
     // And saw it live, at the profile's end, as the report has it.

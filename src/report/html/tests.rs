@@ -45,6 +45,7 @@ fn section(radius: f64, azimuth_deg: f64, lift_mm: f64) -> Vec<PointRecord> {
                 off_plane_mm: 0.0,
                 quality: 1.0,
                 flagged: false,
+                after_fit_mm: None,
             }
         })
         .collect()
@@ -358,4 +359,30 @@ fn toleranced_parameters_are_marked_with_their_limits_and_each_failure_listed() 
     ] {
         assert!(html.contains(text), "{text} not in the page:\n{html}");
     }
+}
+
+#[test]
+fn a_profile_fitted_best_gets_a_third_whisker_plot_of_its_form_after_the_fit() {
+    let mut report = three_blades();
+    // B's first profile, 0.2 mm off before the fit, is within 2 um of the nominal after it.
+    for point in &mut report.instances[1].profiles[0].points {
+        point.after_fit_mm = Some(0.002);
+    }
+    let html = report_html(&report).unwrap();
+    let plots = svgs(&html);
+    assert_eq!(plots.len(), 2 * PROFILES.len() + 1);
+    let after = plots[2];
+    assert_well_formed(after);
+    let title = format!(
+        "{} after the best fit (shift and twist removed)",
+        PROFILES[0].0
+    );
+    assert!(after.contains(&title), "{after}");
+    // The largest deviation after the fit, 0.002 mm, against the 80 mm chord: 0.1 * 80 / 0.002 = 4000, x 5000.
+    assert!(after.contains("whiskers x 5000 "), "{after}");
+    assert!(
+        plots[1].contains("whiskers x 50 "),
+        "as measured, unchanged"
+    );
+    assert!(html.contains("its form error.</figcaption>"));
 }

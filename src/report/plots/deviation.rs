@@ -163,6 +163,7 @@ mod tests {
                 v: 0.0,
                 normal: Vector2::zeros(),
                 deviation_mm: angle_deg / 1000.0,
+                after_fit_mm: None,
                 angle_deg,
             })
             .collect()

@@ -19,6 +19,8 @@ pub struct SectionPoint {
     /// perpendicular to the plane (no in-plane direction to draw its deviation along).
     pub normal: Vector2<f64>,
     pub deviation_mm: f64,
+    /// The deviation after the section's least-squares best fit, where the report has it.
+    pub after_fit_mm: Option<f64>,
     /// Angle about the section's centroid, from its chord, counter-clockwise in (u, v), in (-180, 180] degrees.
     pub angle_deg: f64,
 }
@@ -62,6 +64,7 @@ pub fn project_section(points: &[PointRecord]) -> Option<Vec<SectionPoint>> {
                     .try_normalize(NEGLIGIBLE)
                     .unwrap_or_else(Vector2::zeros),
                 deviation_mm: point.deviation_mm,
+                after_fit_mm: point.after_fit_mm,
                 angle_deg: angle.to_degrees(),
             }
         })
@@ -149,6 +152,7 @@ mod tests {
                     off_plane_mm: 0.0,
                     quality: 1.0,
                     flagged: false,
+                    after_fit_mm: None,
                 }
             })
             .collect()

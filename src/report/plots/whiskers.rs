@@ -203,6 +203,7 @@ mod tests {
             v,
             normal: Vector2::from(normal),
             deviation_mm,
+            after_fit_mm: None,
             angle_deg: 0.0,
         }
     }

@@ -42,6 +42,7 @@ fn profile(name: &str, x_mm: f64, machine: &str, deviations: [f64; 6]) -> Profil
                 off_plane_mm: 0.0003 * t,
                 quality: 0.5 + 0.1 * t,
                 flagged: false,
+                after_fit_mm: None,
             }
         })
         .collect();
