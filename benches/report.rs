@@ -63,6 +63,7 @@ fn profile(blade: usize, x: f64, shift: f64) -> ProfileReport {
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
         parameters: None,
+        distribution: None,
         points,
     }
 }

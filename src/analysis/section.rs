@@ -300,13 +300,52 @@ impl SectionParametersReport {
     }
 }
 
+/// Stations at most, of each side of a [`SectionDistribution`]: enough to draw the thickness and camber along the
+/// chord, few enough to keep every report's file small.
+const DISTRIBUTION_STATIONS: usize = 50;
+
+/// A section's thickness and camber along its chord, as the nominal has them and as measured.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
+pub struct SectionDistribution {
+    /// Per station along the mean line, leading edge first: [place along the chord line as a fraction of it from
+    /// the leading end, thickness mm (the inscribed circle's diameter), camber mm (the mean line's distance from
+    /// its chord line, + on the side the chord turned +90 deg points to)].
+    pub nominal: Vec<[f64; 3]>,
+    pub measured: Vec<[f64; 3]>,
+}
+
+impl SectionDistribution {
+    fn of(nominal: &SectionParameters, measured: &SectionParameters) -> Self {
+        let stations = |p: &SectionParameters| -> Vec<[f64; 3]> {
+            let all: Vec<[f64; 3]> = p
+                .mean_line
+                .distribution()
+                .map(|(a, t, c)| [a, t, c])
+                .collect();
+            let step = all.len().div_ceil(DISTRIBUTION_STATIONS).max(1);
+            all.into_iter().step_by(step).collect()
+        };
+        SectionDistribution {
+            nominal: stations(nominal),
+            measured: stations(measured),
+        }
+    }
+}
+
+/// A scanned section's parameters and its thickness and camber along the chord.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionShape {
+    pub parameters: SectionParametersReport,
+    pub distribution: SectionDistribution,
+}
+
 /// The parameters of the section scanned as `points` (part frame, in scan order round it, flagged contacts left
 /// out) beside `nominal`'s; `radius_mm` is the section's radius about a propeller's hub axis, if it is one.
 pub fn parameters(
     nominal: &SectionParameters,
     points: &[Point3<f64>],
     radius_mm: Option<f64>,
-) -> Result<SectionParametersReport, String> {
+) -> Result<SectionShape, String> {
     let in_plane: Vec<Vector2<f64>> = points.iter().map(|p| Vector2::new(p.y, p.z)).collect();
     let measured = section_parameters(&in_plane, EDGE_DISTANCE_MM).map_err(|e| e.to_string())?;
     let value =
@@ -317,7 +356,7 @@ pub fn parameters(
     let pitch = |p: &SectionParameters, r: f64| {
         std::f64::consts::TAU * r * p.mean_line.chord_angle_deg.to_radians().tan()
     };
-    Ok(SectionParametersReport {
+    let parameters = SectionParametersReport {
         edge_distance_mm: EDGE_DISTANCE_MM,
         chord_mm: value(|p| p.chord_mm),
         max_thickness_mm: value(|p| p.max_thickness_mm),
@@ -335,6 +374,10 @@ pub fn parameters(
         ]),
         pitch_mm: radius_mm.map(|r| ParameterValue::of(pitch(nominal, r), pitch(&measured, r))),
         verdict: None,
+    };
+    Ok(SectionShape {
+        parameters,
+        distribution: SectionDistribution::of(nominal, &measured),
     })
 }
 

@@ -96,6 +96,8 @@ pub struct SectionParameters {
 pub struct MeanLine {
     /// Inscribed circles' centres at stations along the chord, leading edge first.
     pub points: Vec<Vector2<f64>>,
+    /// ... and their diameters, the section's thickness there (mm).
+    pub thicknesses_mm: Vec<f64>,
     pub leading_end: Vector2<f64>,
     pub trailing_end: Vector2<f64>,
     /// The largest distance of the mean line from its chord line, + on the side the chord turned +90 deg points
@@ -106,6 +108,23 @@ pub struct MeanLine {
     /// The chord line's direction, leading to trailing end, from the outline's first axis towards its second
     /// (deg, in (-180, 180]).
     pub chord_angle_deg: f64,
+}
+
+impl MeanLine {
+    /// Each point's (place along the chord line as a fraction of it from the leading end, thickness mm, camber mm:
+    /// its distance from the chord line, signed as [`MeanLine::max_camber_mm`]).
+    pub fn distribution(&self) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
+        let chord = self.trailing_end - self.leading_end;
+        let along = chord.normalize();
+        let normal = Vector2::new(-along.y, along.x);
+        self.points
+            .iter()
+            .zip(&self.thicknesses_mm)
+            .map(move |(c, &thickness)| {
+                let d = c - self.leading_end;
+                (d.dot(&along) / chord.norm(), thickness, d.dot(&normal))
+            })
+    }
 }
 
 /// Why a section has no parameters.
@@ -226,6 +245,7 @@ impl MeanLine {
     fn of(across: &Across, chord_mm: f64) -> Result<MeanLine, ParameterError> {
         let clear = END_CLEARANCE * chord_mm;
         let mut centres = Vec::new();
+        let mut thicknesses_mm = Vec::new();
         // In the chord's frame: x along the chord from the leading edge, y across it.
         let mut local = Vec::new();
         for k in 1..MEAN_LINE_STATIONS {
@@ -234,6 +254,7 @@ impl MeanLine {
             if s - radius > clear && chord_mm - s - radius > clear {
                 let d = centre - across.origin;
                 centres.push(centre);
+                thicknesses_mm.push(2.0 * radius);
                 local.push((d.dot(&across.along), d.dot(&across.normal)));
             }
         }
@@ -292,6 +313,7 @@ impl MeanLine {
         }
         Ok(MeanLine {
             points: centres,
+            thicknesses_mm,
             leading_end,
             trailing_end,
             max_camber_mm,

@@ -5,7 +5,8 @@ use std::fmt::Write;
 use std::path::Path;
 
 use super::plots::{
-    after_best_fit, deviation_svg, profile_figures, whisker_svg, PlotError, ProfileFigures,
+    after_best_fit, deviation_svg, distribution_svg, profile_figures, whisker_svg, PlotError,
+    ProfileFigures,
 };
 use super::summary::{
     deviation, machine_text, parameter_failures, parameter_tolerances_text, COORDINATE_DECIMALS,
@@ -404,6 +405,16 @@ fn profile_figures_html(
             "<figure>\n{}\n<figcaption>{}: each point's deviation once its section's least-squares best fit \
              (the shifts and twist in the best-fit table) is removed, its form error.</figcaption>\n</figure>",
             whisker_svg(&name, &fitted)?,
+            escape(figures.name)
+        )
+        .expect("writing to a String");
+    }
+    if let Some(svg) = distribution_svg(figures.name, &figures.sections)? {
+        writeln!(
+            html,
+            "<figure>\n{svg}\n<figcaption>{}: each blade's thickness (the diameter of the circle inscribed at each \
+             station of its mean line) and camber (the mean line's distance from its chord line), measured minus \
+             the nominal's at the same place along the chord.</figcaption>\n</figure>",
             escape(figures.name)
         )
         .expect("writing to a String");

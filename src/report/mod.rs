@@ -19,7 +19,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::section::{ParameterValue, SectionBestFit, SectionParametersReport};
+use crate::analysis::section::{
+    ParameterValue, SectionBestFit, SectionDistribution, SectionParametersReport,
+};
 use crate::analysis::stats::{DeviationStats, Tolerance, Verdict};
 use crate::analysis::tolerances::Iso484Class;
 pub use export::history_csv;
@@ -150,6 +152,9 @@ pub struct ProfileReport {
     /// daemon's log).
     #[serde(default)]
     pub parameters: Option<SectionParametersReport>,
+    /// The section's thickness and camber along its chord, nominal and measured, where it has parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distribution: Option<SectionDistribution>,
     pub points: Vec<PointRecord>,
 }
 

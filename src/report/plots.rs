@@ -1,14 +1,18 @@
 //! The report's figures, one SVG string each, drawn with plotters: per profile, every instance's deviation along
-//! the section (seed 003's figures 4-6) and the sections with their deviations as whiskers along the normals.
+//! the section (seed 003's figures 4-6), the sections with their deviations as whiskers along the normals (as
+//! measured and after each section's best fit), and their thickness and camber along the chord against nominal.
 
 mod deviation;
+mod distribution;
 mod section;
 mod whiskers;
 
 use plotters::style::RGBColor;
 
 use super::{PartReport, ProfileReport};
+use crate::analysis::section::SectionDistribution;
 pub use deviation::deviation_svg;
+pub use distribution::distribution_svg;
 pub use section::{project_section, SectionPoint};
 pub use whiskers::whisker_svg;
 
@@ -18,6 +22,8 @@ pub struct InstanceSection<'a> {
     /// The instance's place in the report, so that it keeps its colour in every figure.
     pub colour: RGBColor,
     pub points: Vec<SectionPoint>,
+    /// Its thickness and camber along the chord, nominal and measured, where the report has them.
+    pub distribution: Option<&'a SectionDistribution>,
 }
 
 /// A profile across the instances: the sections that could be projected and the instances whose scan could not
@@ -61,6 +67,7 @@ fn add_scan<'a>(
             instance,
             colour: instance_colour(index),
             points,
+            distribution: profile.distribution.as_ref(),
         }),
         None => figure.unplotted.push(instance),
     }
@@ -80,6 +87,7 @@ pub fn after_best_fit<'a>(sections: &[InstanceSection<'a>]) -> Option<Vec<Instan
             .map(|section| InstanceSection {
                 instance: section.instance,
                 colour: section.colour,
+                distribution: section.distribution,
                 points: section
                     .points
                     .iter()

@@ -51,6 +51,7 @@ fn profile(
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
         parameters: None,
+        distribution: None,
         points,
     };
     (report, stats, outside)

@@ -267,18 +267,22 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     Vec::new()
                 }
             };
-            let parameters = inputs.gauges[key.profile]
+            let shape = inputs.gauges[key.profile]
                 .nominal_parameters()
                 .map_err(str::to_string)
                 .and_then(|nominal| section::parameters(nominal, &in_part, plan.profile_radius(key.profile)))
-                .map(|mut parameters| {
-                    tolerances.judge_section(&mut parameters);
-                    parameters
+                .map(|mut shape| {
+                    tolerances.judge_section(&mut shape.parameters);
+                    shape
                 })
                 .map_err(|problem| {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no parameters of the section");
                 })
                 .ok();
+            let (parameters, distribution) = match shape {
+                Some(shape) => (Some(shape.parameters), Some(shape.distribution)),
+                None => (None, None),
+            };
             let section_failures = parameters
                 .as_ref()
                 .map_or(0, |p| failures(p.judged().map(|(_, v)| v)));
@@ -296,6 +300,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     .with_parameters_outside(section_failures, summary.worst_mm),
                 best_fits,
                 parameters,
+                distribution,
                 points,
             });
         }

@@ -249,6 +249,7 @@ impl Pipeline {
                 .nominal_parameters()
                 .map_err(str::to_string)
                 .and_then(|nominal| section::parameters(nominal, &in_part, radius))
+                .map(|shape| shape.parameters)
                 .map(|mut parameters| {
                     tolerances.judge_section(&mut parameters);
                     parameters

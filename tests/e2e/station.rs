@@ -384,9 +384,9 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     if let Some(dom) = render_in_a_browser(&dir.join("report.html")) {
         assert_eq!(
             dom.matches("<svg").count(),
-            3 * 5,
-            "per profile in the rendered page: a deviation plot, and whisker plots as measured and after the \
-             best fit"
+            4 * 5,
+            "per profile in the rendered page: a deviation plot, whisker plots as measured and after the best \
+             fit, and the thickness and camber along the chord"
         );
     }
     // The same numbers in every report of the inspection.
@@ -394,8 +394,9 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert_eq!(
         html.matches("<svg").count(),
-        3 * 5,
-        "a deviation plot and two whisker plots (as measured, after the best fit) per profile"
+        4 * 5,
+        "per profile: a deviation plot, two whisker plots (as measured, after the best fit) and the thickness and \
+         camber along the chord"
     );
     assert!(
         html.contains(&format!("{:+.4}", b300.stats.mean_mm)),

@@ -83,6 +83,7 @@ fn instance(name: &str, azimuth_deg: f64, lift_per_100_mm: f64) -> InstanceRepor
                 verdict,
                 best_fits: Vec::new(),
                 parameters: None,
+                distribution: None,
                 points,
             }
         })
@@ -385,4 +386,44 @@ fn a_profile_fitted_best_gets_a_third_whisker_plot_of_its_form_after_the_fit() {
         "as measured, unchanged"
     );
     assert!(html.contains("its form error.</figcaption>"));
+}
+
+#[test]
+fn a_section_with_parameters_gets_its_thickness_and_camber_along_the_chord_drawn() {
+    let mut report = three_blades();
+    let stations = |thicker: f64| -> Vec<[f64; 3]> {
+        (0..=20)
+            .map(|k| {
+                let at = k as f64 / 20.0;
+                [at, thicker + 12.0 * at * (1.0 - at), 0.4 * at * (1.0 - at)]
+            })
+            .collect()
+    };
+    report.instances[2].profiles[0].distribution =
+        Some(crate::analysis::section::SectionDistribution {
+            nominal: stations(0.0),
+            measured: stations(0.0125),
+        });
+    let html = report_html(&report).unwrap();
+    let plots = svgs(&html);
+    assert_eq!(plots.len(), 2 * PROFILES.len() + 1);
+    let figure = plots[2];
+    assert_well_formed(figure);
+    assert!(
+        figure.contains(&format!(
+            "{}: measured minus nominal along the chord (mm)",
+            PROFILES[0].0
+        )),
+        "{figure}"
+    );
+    assert!(figure.contains("along the chord from the leading edge (%)"));
+    assert!(
+        figure.contains(&svg_text("C")),
+        "the blade with one, labelled"
+    );
+    assert!(
+        !figure.contains(&svg_text("A")),
+        "blades without one left out"
+    );
+    assert!(html.contains("measured minus the nominal's at the same place along the chord"));
 }

@@ -185,6 +185,7 @@ mod tests {
         let sections = [InstanceSection {
             instance: "B",
             colour: BLACK,
+            distribution: None,
             points: at_angles(&[-50.0, 120.0, 170.0]),
         }];
         let range = deviation_range(&sections, &tolerance);

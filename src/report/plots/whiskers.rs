@@ -219,6 +219,7 @@ mod tests {
         let sections = [InstanceSection {
             instance: "B",
             colour: BLACK,
+            distribution: None,
             points: vec![
                 point(0.0, 0.0, [0.0, 1.0], -0.93),
                 point(150.0, 10.0, [0.0, 1.0], 0.2),

@@ -56,6 +56,7 @@ fn profile(name: &str, x_mm: f64, machine: &str, deviations: [f64; 6]) -> Profil
         verdict: TOLERANCE.verdict(&summary, outside),
         best_fits: Vec::new(),
         parameters: None,
+        distribution: None,
         points,
     }
 }
