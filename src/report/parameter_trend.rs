@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 use super::individuals::{individuals, Individuals};
 use super::store::ParameterRecord;
-use super::trend::{mean, sample_deviation, FEW_PARTS};
+use super::trend::{few_parts_warning, mean, sample_deviation};
 
 /// One part's value of one parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -161,13 +161,10 @@ pub fn parameter_trend_text(rows: &[ParameterTrendRow]) -> String {
             row.signalled()
         ));
     }
-    let fewest = rows.iter().map(|r| r.parts.len()).min().unwrap_or(0);
-    if fewest < FEW_PARTS {
-        text.push_str(&format!(
-            "warning: {fewest} parts with parameters in the history; Cp and Cpk need {FEW_PARTS} or more to be \
-             trusted\n"
-        ));
-    }
+    text.push_str(&few_parts_warning(
+        rows.iter().map(|r| r.parts.len()),
+        "parts with parameters in the history",
+    ));
     text
 }
 

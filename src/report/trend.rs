@@ -170,6 +170,17 @@ pub(super) fn sample_deviation(values: &[f64], mean: f64) -> f64 {
     (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (values.len() - 1) as f64).sqrt()
 }
 
+/// A warning line when the fewest of `parts` (each row's count) is too few to trust Cp and Cpk; empty otherwise.
+/// `what` names what was counted, e.g. "parts in the history".
+pub(super) fn few_parts_warning(parts: impl Iterator<Item = usize>, what: &str) -> String {
+    let fewest = parts.min().unwrap_or(0);
+    if fewest < FEW_PARTS {
+        format!("warning: {fewest} {what}; Cp and Cpk need {FEW_PARTS} or more to be trusted\n")
+    } else {
+        String::new()
+    }
+}
+
 /// The trend as a table an engineer reads, units stated, with a warning when the history is short.
 pub fn trend_text(rows: &[TrendRow], lower_mm: f64, upper_mm: f64) -> String {
     let index = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
@@ -215,12 +226,10 @@ pub fn trend_text(rows: &[TrendRow], lower_mm: f64, upper_mm: f64) -> String {
             row.signalled()
         ));
     }
-    let fewest = rows.iter().map(|r| r.parts.len()).min().unwrap_or(0);
-    if fewest < FEW_PARTS {
-        text.push_str(&format!(
-            "warning: {fewest} parts in the history; Cp and Cpk need {FEW_PARTS} or more to be trusted\n"
-        ));
-    }
+    text.push_str(&few_parts_warning(
+        rows.iter().map(|r| r.parts.len()),
+        "parts in the history",
+    ));
     text
 }
 

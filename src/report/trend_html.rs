@@ -176,16 +176,10 @@ fn profile_table(rows: &[TrendRow]) -> String {
         ] {
             write!(html, "<td>{value}</td>").expect("writing to a String");
         }
-        for index in [row.cp, row.cpk] {
-            html.push_str(&match index {
-                Some(v) => cell(format!("{v:.2}"), v < CAPABLE),
-                None => "<td>-</td>".to_string(),
-            });
-        }
         writeln!(
             html,
             "{}</tr>",
-            cell(row.signalled().to_string(), row.signalled() > 0)
+            capability_cells(row.cp, row.cpk, row.signalled())
         )
         .expect("writing to a String");
     }
@@ -221,16 +215,10 @@ fn parameter_table(rows: &[ParameterTrendRow]) -> String {
             escape(&tolerance)
         )
         .expect("writing to a String");
-        for index in [row.cp, row.cpk] {
-            html.push_str(&match index {
-                Some(v) => cell(format!("{v:.2}"), v < CAPABLE),
-                None => "<td>-</td>".to_string(),
-            });
-        }
         writeln!(
             html,
             "{}</tr>",
-            cell(row.signalled().to_string(), row.signalled() > 0)
+            capability_cells(row.cp, row.cpk, row.signalled())
         )
         .expect("writing to a String");
     }
@@ -280,6 +268,19 @@ fn parts_table(row: &TrendRow, lower_mm: f64, upper_mm: f64) -> String {
     }
     html.push_str("</table>\n</details>\n");
     html
+}
+
+/// The Cp, Cpk and control-signal cells of a row, each marked failing when it is below capable or signalled.
+fn capability_cells(cp: Option<f64>, cpk: Option<f64>, signalled: usize) -> String {
+    let mut cells: String = [cp, cpk]
+        .iter()
+        .map(|index| match index {
+            Some(v) => cell(format!("{v:.2}"), *v < CAPABLE),
+            None => "<td>-</td>".to_string(),
+        })
+        .collect();
+    cells.push_str(&cell(signalled.to_string(), signalled > 0));
+    cells
 }
 
 /// A table cell, marked failing when `bad`.
