@@ -9,7 +9,8 @@
 //! | `disconnect`          | ms      | the line goes dead for `ms` (TCP: closed); the session is lost        |
 //! | `estop`               |         | `E0000 ! Error(3, 0500, ...)`: motion stops, ClearAllErrors needed    |
 //! | `collision`           |         | the next move stops halfway with 2504                                |
-//! | `no-touch`            |         | the next PtMeas finds no surface: 1003                                |
+//! | `no-touch`            |         | the next PtMeas finds no surface, or the next scan loses its touch    |
+//! |                       |         | halfway (its first half's points sent, the probe stopped there): 1003 |
 //! | `surface-not-found`   |         | the next scan finds no surface: 1006                                  |
 //!
 //! Delays and dead lines are wall-clock times, not scaled by `time_scale`: they exist to exercise the

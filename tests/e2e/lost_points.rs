@@ -185,3 +185,82 @@ fn a_lost_line_then_clear_reconnects_and_the_job_continues_whole() {
     assert_eq!(point_counts(&report), point_counts(&whole));
     assert_no_repeated_points(&report);
 }
+
+#[test]
+fn a_scan_that_loses_its_touch_partway_stops_and_after_the_clear_is_scanned_again_whole() {
+    let mut station = station();
+    station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
+    let (_, whole) = station.report("SN-WHOLE");
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", "SN-TOUCH", "--detach"]);
+    // Armed during one scan, the fault takes the next: that scan sends its first half, then 1003.
+    watcher.until(60, |e| matches!(e, Event::Point { index: 20, .. }));
+    assert_eq!(
+        station.sim.control("fault cmm1 no-touch"),
+        "ok fault cmm1 no-touch"
+    );
+    let stopped = watcher.until(60, |e| matches!(e, Event::JobStopped { .. }));
+    let Event::JobStopped {
+        machine,
+        scan,
+        reason,
+        next_step,
+        ..
+    } = &stopped
+    else {
+        unreachable!()
+    };
+    assert_eq!(machine.as_deref(), Some("cmm1"), "{stopped:?}");
+    assert!(scan.is_some(), "the stop names the profile: {stopped:?}");
+    assert!(reason.contains("1003"), "{reason}");
+    assert!(next_step.contains("zeroset clear"), "{next_step}");
+    let cleared = station.cli_ok(&["clear"]);
+    assert!(cleared.contains("continues"), "{cleared}");
+    let end = watcher.until(120, job_over);
+    assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
+    let (_, report) = station.report("SN-TOUCH");
+    assert_eq!(point_counts(&report), point_counts(&whole));
+    assert_no_repeated_points(&report);
+    let transcript = std::fs::read_to_string(station.sim.transcript("cmm1")).unwrap();
+    let lost: Vec<&str> = transcript
+        .lines()
+        .filter(|l| l.contains("! Error(") && l.contains(", 1003,"))
+        .collect();
+    assert_eq!(lost.len(), 1, "{lost:?}");
+}
+
+#[test]
+fn a_teach_scan_that_loses_its_touch_partway_is_cleared_without_a_collision_and_the_teach_finishes()
+{
+    let mut station = station();
+    let mut watcher = station.watch();
+    station.cli_ok(&["teach", "propeller", "--detach"]);
+    watcher.until(120, |e| matches!(e, Event::Point { index: 35, .. }));
+    assert_eq!(
+        station.sim.control("fault cmm1 no-touch"),
+        "ok fault cmm1 no-touch"
+    );
+    let stopped = watcher.until(120, |e| matches!(e, Event::JobStopped { .. }));
+    let Event::JobStopped { reason, scan, .. } = &stopped else {
+        unreachable!()
+    };
+    assert!(reason.contains("1003") && scan.is_some(), "{stopped:?}");
+    let cleared = station.cli(&["clear"]);
+    assert!(
+        cleared.success && cleared.stdout.contains("continues"),
+        "{}{}",
+        cleared.stdout,
+        cleared.stderr
+    );
+    let end = watcher.until(240, job_over);
+    assert!(matches!(end, Event::ReferenceSaved { .. }), "{end:?}");
+    let transcript = std::fs::read_to_string(station.sim.transcript("cmm1")).unwrap();
+    let errors: Vec<&str> = transcript
+        .lines()
+        .filter(|l| l.contains("! Error(") && (l.contains(", 2504,") || l.contains(", 1003,")))
+        .collect();
+    assert!(
+        errors.len() == 1 && errors[0].contains(", 1003,"),
+        "one lost touch and no collision on the way out: {errors:?}"
+    );
+}

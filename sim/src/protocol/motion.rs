@@ -294,6 +294,12 @@ pub fn ptmeas(
     timeline.finish()
 }
 
+/// How many of a scan's `count` points are measured before an armed `no-touch` fault loses the touch: the first
+/// half. The machine stops where it last touched, the points it measured sent, then 1003.
+fn touch_lost_after(count: usize) -> usize {
+    count.div_ceil(2)
+}
+
 /// The probing at a scan's start: approach, search, and the contact, or the error to report.
 fn probe_start(
     timeline: &mut Timeline,
@@ -366,13 +372,20 @@ pub fn scan_in_plane(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
         radius: diameter / 2.0,
         count: count as u32,
     };
-    let contacts = match plane_scan(&section, world.radius, contact.centre, d, step, stop) {
+    let mut contacts = match plane_scan(&section, world.radius, contact.centre, d, step, stop) {
         Ok(contacts) => contacts,
         Err(_) => return timeline.fail(code::ERROR_PROCESSING_METHOD),
     };
+    let touch_lost = std::mem::take(&mut world.armed.no_touch);
+    if touch_lost {
+        contacts.truncate(touch_lost_after(contacts.len()));
+    }
     let centres: Vec<Point3<f64>> = contacts.iter().map(|c| c.centre).collect();
     let times = timeline.trajectory.follow(&centres, world.scan_limits());
     timeline.send_points(world, &contacts, &times);
+    if touch_lost {
+        return timeline.fail(code::NO_TOUCH);
+    }
     let last = *centres.last().expect("a scan has its start point");
     let retract = world.props.ptmeas_retract.act.max(0.0);
     let limits = world.goto_limits();
@@ -409,10 +422,15 @@ pub fn scan_on_curve(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
     if std::mem::take(&mut world.armed.surface_not_found) {
         return timeline.fail(code::SURFACE_NOT_FOUND);
     }
+    let touch_lost = std::mem::take(&mut world.armed.no_touch);
     let mut path = vec![approach];
     let mut measured = Vec::new();
-    let mut failed = false;
-    for nominal in &nominals {
+    let mut failed = None;
+    for (index, nominal) in nominals.iter().enumerate() {
+        if touch_lost && index == touch_lost_after(nominals.len()) {
+            failed = Some(code::NO_TOUCH);
+            break;
+        }
         let centre_at = |offset: f64| nominal.point + nominal.normal * (world.radius + offset);
         if !nominal.on_surface {
             path.push(centre_at(window));
@@ -426,7 +444,7 @@ pub fn scan_on_curve(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
                 measured.push((path.len() - 1, contact));
             }
             None => {
-                failed = true;
+                failed = Some(code::SURFACE_NOT_FOUND);
                 break;
             }
         }
@@ -435,8 +453,8 @@ pub fn scan_on_curve(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
     let contacts: Vec<Contact> = measured.iter().map(|(_, c)| *c).collect();
     let point_times: Vec<f64> = measured.iter().map(|(i, _)| times[*i]).collect();
     timeline.send_points(world, &contacts, &point_times);
-    if failed {
-        return timeline.fail(code::SURFACE_NOT_FOUND);
+    if let Some(code) = failed {
+        return timeline.fail(code);
     }
     let last = nominals.last().expect("at least one nominal");
     let retract = world.props.ptmeas_retract.act.max(0.0);

@@ -220,6 +220,100 @@ fn ptmeas_reports_the_ball_centre_and_normal_or_no_touch() {
     assert!(miss[1].contains("1003"), "{miss:?}");
 }
 
+/// The points of a scan's data lines (`X, Y, Z, I, J, K` each, the default scan report of ball centres and
+/// normals), and its error line if it failed.
+fn scan_points_and_error(lines: &[String]) -> (Vec<Point3<f64>>, Option<&String>) {
+    let mut points = Vec::new();
+    for line in lines.iter().filter(|l| l.contains(" # ")) {
+        let values: Vec<f64> = line
+            .split_once(" # ")
+            .unwrap()
+            .1
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect();
+        points.extend(values.chunks(6).map(|v| Point3::new(v[0], v[1], v[2])));
+    }
+    (points, lines.iter().find(|l| l.contains(" ! ")))
+}
+
+/// An in-plane scan of blade A at r200, from above the middle of its chord round the section.
+fn in_plane_scan_line(bench: &Bench, tag: u32) -> String {
+    let top = bench.top_of_blade_a(200.0);
+    let (y, z) = (top.y, top.z);
+    format!(
+        "{tag:05} ScanInPlaneEndIsSphere(200, {y:.5}, {z:.5}, 0, 0, 1, 1, 0, 0, 200, {:.5}, {z:.5}, 1, \
+         200, {y:.5}, {:.5}, 3, 1, 0, 0, 1)",
+        y + 10.0,
+        z + 1.0,
+    )
+}
+
+/// A curve scan along blade A's upper face at r200, 41 nominals 1 mm apart, 0.5 mm expected deviation.
+fn curve_scan_line(bench: &Bench, tag: u32) -> String {
+    let frame = bench.propeller.section_frame(0, 200.0);
+    let section = SampledCurve::new(bench.propeller.section_curve(0, 200.0));
+    let top = section.nearest(&Point2::new(0.0, 100.0)).on_curve;
+    let mut data = Vec::new();
+    for k in -20..=20 {
+        let along = section
+            .nearest(&Point2::new(top.point.x + f64::from(k), 100.0))
+            .on_curve;
+        let p = frame.world(along.point.x, along.point.y, 0.0);
+        let n = frame.world_dir(along.normal.x, along.normal.y, 0.0);
+        data.push(format!(
+            "{:.6}, {:.6}, {:.6}, {:.6}, {:.6}, {:.6}, 1",
+            p.x, p.y, p.z, n.x, n.y, n.z
+        ));
+    }
+    format!(
+        "{tag:05} ScanOnCurve(Closed(0), Format(X(), Y(), Z(), IJK(), tag), Data({}))",
+        data.join(", ")
+    )
+}
+
+#[test]
+fn a_scan_that_loses_its_touch_sends_its_first_half_then_1003_and_stops_where_it_touched_last() {
+    for (what, scan) in [
+        ("in plane", in_plane_scan_line as fn(&Bench, u32) -> String),
+        ("on curve", curve_scan_line),
+    ] {
+        let mut bench = Bench::new();
+        bench.ready();
+        bench.send("00003 OnScanReport(X(), Y(), Z(), IJK())", 0.0);
+        bench.send("00004 ScanOnCurveHint(0.5, 0.5)", 0.0);
+        bench.send("00005 ScanOnCurveDensity(AtNominals(1))", 0.0);
+        bench.send("00006 GoTo(X(200), Y(0), Z(100))", 100.0);
+        let whole = bench.send(&scan(&bench, 7), 1000.0);
+        let (all, error) = scan_points_and_error(&whole);
+        assert!(error.is_none() && all.len() > 20, "{what}: {whole:?}");
+        assert_eq!(whole.last().unwrap(), "00007 %", "{what}");
+
+        bench.send("00008 GoTo(X(200), Y(0), Z(100))", 100.0);
+        bench.controller.arm(Armed {
+            no_touch: true,
+            ..Armed::default()
+        });
+        let lost = bench.send(&scan(&bench, 9), 1000.0);
+        let (half, error) = scan_points_and_error(&lost);
+        let error = error.unwrap_or_else(|| panic!("{what}: {lost:?}"));
+        assert!(error.contains(", 1003, "), "{what}: {error}");
+        assert_eq!(bench.controller.armed(), Armed::default(), "{what}");
+        assert_eq!(half.len(), all.len().div_ceil(2), "{what}");
+        for (a, b) in half.iter().zip(&all) {
+            assert!((a - b).norm() < 0.05, "{what}: {a} against {b}");
+        }
+        let last = half.last().unwrap();
+        let here = bench.controller.position(bench.now + 10.0);
+        assert!(
+            (here - last).norm() < 0.05,
+            "{what}: stopped at {here}, last touched {last}"
+        );
+        let refused = bench.send("00010 GoTo(X(200), Y(0), Z(100))", 100.0);
+        assert!(refused[1].contains("0514"), "{what}: {refused:?}");
+    }
+}
+
 #[test]
 fn abort_stops_a_scan_and_wants_clear_all_errors() {
     let mut bench = Bench::new();

@@ -14,4 +14,5 @@ mod tally;
 mod transcript;
 mod wire_log;
 
+pub(crate) use plan::Kind;
 pub(crate) use run::{run, Options};

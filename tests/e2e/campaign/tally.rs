@@ -84,17 +84,10 @@ impl Tally {
             );
             match kind {
                 Kind::DropLines => out.push_str("   (fired: reply lines dropped)"),
-                Kind::NoTouch => {
-                    let _ = write!(
-                        out,
-                        "   (armed {} times, fired {} times: the station sends no PtMeas)",
-                        self.count(&self.injected, kind),
-                        self.count(&self.fired, kind)
-                    );
-                }
                 Kind::Collision | Kind::SurfaceNotFound => {
                     out.push_str("   (armed twice before a move fires once)")
                 }
+                Kind::NoTouch => out.push_str("   (armed twice before a scan fires once)"),
                 _ => {}
             }
             out.push('\n');

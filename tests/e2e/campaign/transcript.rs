@@ -163,7 +163,7 @@ impl TranscriptWatch {
                 None
             }
             COLLISION => self.met(Kind::Collision, "a collision"),
-            NO_TOUCH => self.met(Kind::NoTouch, "a probing that touched nothing"),
+            NO_TOUCH => self.met(Kind::NoTouch, "a probing or scan that lost its touch"),
             SURFACE_NOT_FOUND => self.met(Kind::SurfaceNotFound, "a scan that found no surface"),
             _ => None,
         };
