@@ -15,7 +15,7 @@ use rand::rngs::StdRng;
 use rand::SeedableRng;
 use zeroset::analysis::deviation::ProfileGauge;
 use zeroset::analysis::reference::{teach, ReferenceSettings};
-use zeroset::analysis::section::{best_fits, parameters};
+use zeroset::analysis::section::{best_fits, parameters, BestFitSettings};
 use zeroset::geometry::fit3l::FitMethod;
 
 const POINTS: usize = 2000;
@@ -44,7 +44,9 @@ fn section_evaluation(c: &mut Criterion) {
         .map(|p| p + Vector3::new(0.0, 0.0, 0.4))
         .collect();
     // A check that the bench times real work: the fit finds the 0.4 mm move.
-    let fits = best_fits(&gauge, &points).expect("best fits").fits;
+    let fits = best_fits(&gauge, &points, &BestFitSettings::default())
+        .expect("best fits")
+        .fits;
     eprintln!(
         "r300, {POINTS} points moved 0.4 mm along z: l2 shift ({:+.4}, {:+.4}) mm, minzone zone {:.4} mm",
         fits[0].shift_mm[0], fits[0].shift_mm[1], fits[1].form.zone_mm
@@ -52,7 +54,7 @@ fn section_evaluation(c: &mut Criterion) {
     let mut group = c.benchmark_group(format!("section r300, {POINTS} points"));
     group.sample_size(20).sampling_mode(SamplingMode::Flat);
     group.bench_function("best fits, l2 and minzone", |b| {
-        b.iter(|| best_fits(&gauge, &points).expect("best fits"))
+        b.iter(|| best_fits(&gauge, &points, &BestFitSettings::default()).expect("best fits"))
     });
     group.bench_function("parameters", |b| {
         b.iter(|| parameters(&nominal, &points, Some(X_MM)).expect("parameters"))

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
 
 use crate::analysis::reference::Reference;
+use crate::analysis::section::BestFitSettings;
 use crate::analysis::NominalPoint;
 use crate::config::{
     ConfigError, PartConfig, ProfileEntry, ReferenceSettings, ScanSettings, StationConfig,
@@ -256,6 +257,11 @@ impl Plan {
 
     pub fn tolerance(&self) -> &ToleranceEntry {
         &self.part.tolerance
+    }
+
+    /// What each inspected section's best fits may move, and how far.
+    pub fn best_fit(&self) -> &BestFitSettings {
+        &self.part.best_fit
     }
 
     fn profile(&self, key: ProfileKey) -> &ProfileEntry {

@@ -10,7 +10,7 @@ use super::deviation::ProfileGauge;
 use super::tolerances::{AppliedTolerance, Parameter, ParameterVerdict};
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::project_to_zero_set;
-use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured};
+use crate::geometry::section_fit::{fit_section, FitLimits, FitMethod, FitMode, Form, Measured};
 use crate::geometry::section_parameters::{farthest_pair, section_parameters, SectionParameters};
 use crate::geometry::trace::simplify_closed;
 
@@ -26,6 +26,103 @@ const MODEL_STRAY_MM: f64 = 0.05;
 /// How far in from each edge, along the chord, the edge thicknesses are taken unless told (mm).
 pub(crate) const EDGE_DISTANCE_MM: f64 = 2.0;
 
+/// What each section's best fits may move, and how far: the part file's `[best_fit]`.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct BestFitSettings {
+    #[serde(default)]
+    pub mode: BestFitMode,
+    /// How far (+-) the fit may move a section along its chord and along its thickness, mm, and turn it, deg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_dchord_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_dn_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_rotation_deg: Option<f64>,
+}
+
+/// What a best fit moves.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum BestFitMode {
+    /// The two translations in the section's plane and the twist about the chord's middle.
+    #[default]
+    Full,
+    /// The two translations only: a twist stays in the form.
+    Translation,
+}
+
+impl BestFitMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Full => "full",
+            Self::Translation => "translation",
+        }
+    }
+}
+
+/// How far a best fit may move a section: +- each, mm and deg (none: as far as fits best). A section lying farther
+/// off is fitted to the limit, and the rest of its displacement shows in its form.
+#[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+pub struct BestFitLimits {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dchord_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dn_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_deg: Option<f64>,
+}
+
+impl BestFitLimits {
+    fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
+
+    pub(crate) fn fit_limits(&self) -> FitLimits {
+        FitLimits {
+            dchord_mm: self.dchord_mm,
+            dn_mm: self.dn_mm,
+            rotation_deg: self.rotation_deg,
+        }
+    }
+}
+
+impl BestFitSettings {
+    pub fn limits(&self) -> BestFitLimits {
+        BestFitLimits {
+            dchord_mm: self.max_dchord_mm,
+            dn_mm: self.max_dn_mm,
+            rotation_deg: self.max_rotation_deg,
+        }
+    }
+
+    /// What serde cannot check: each limit a size, and no limit on what the mode does not move.
+    pub(crate) fn check(&self) -> Result<(), String> {
+        for (key, limit) in [
+            ("max_dchord_mm", self.max_dchord_mm),
+            ("max_dn_mm", self.max_dn_mm),
+            ("max_rotation_deg", self.max_rotation_deg),
+        ] {
+            if let Some(limit) = limit {
+                if !(limit.is_finite() && limit >= 0.0) {
+                    return Err(format!(
+                        "{key} = {limit}: a limit is how far (+-) the fit may move a section, a finite \
+                         size of 0 or more; leave it out for no limit"
+                    ));
+                }
+            }
+        }
+        if self.mode == BestFitMode::Translation && self.max_rotation_deg.is_some() {
+            return Err(
+                "max_rotation_deg is given but mode = \"translation\" never turns a section; leave it out, \
+                 or set mode = \"full\""
+                    .into(),
+            );
+        }
+        Ok(())
+    }
+}
+
 /// The form error after a fit, mm.
 #[derive(Serialize, Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct SectionForm {
@@ -39,7 +136,7 @@ pub struct SectionForm {
 /// One best fit of a section: translations and twist about the chord's middle.
 #[derive(Serialize, Deserialize, Debug, Clone, PartialEq)]
 pub struct SectionBestFit {
-    /// What the fit moved: "full" (the two translations and the twist).
+    /// What the fit moved: "full" (the two translations and the twist) or "translation".
     pub mode: String,
     /// "l2" (least squares) or "minzone" (minimum zone).
     pub method: String,
@@ -55,6 +152,31 @@ pub struct SectionBestFit {
     /// The chord's unit direction in (y, z), the thickness direction being it turned by +90 deg.
     pub chord_direction: [f64; 2],
     pub form: SectionForm,
+    /// The limits the fit was held within (+-, mm and deg), where the part file sets any.
+    #[serde(default, skip_serializing_if = "BestFitLimits::is_empty")]
+    pub limits: BestFitLimits,
+    /// The displacements the fit left at their limit ("dchord_mm", "dn_mm", "rotation_deg"): the section lies
+    /// farther off than it may be moved, and the rest shows in its form.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub at_limit: Vec<String>,
+}
+
+impl SectionBestFit {
+    /// The limits the fit was held at, for an operator: "dn +-0.25 mm, twist +-0.01 deg"; `None` when it reached
+    /// none.
+    pub fn held_at(&self) -> Option<String> {
+        let held: Vec<String> = self
+            .at_limit
+            .iter()
+            .filter_map(|name| match name.as_str() {
+                "dchord_mm" => Some(format!("dchord +-{} mm", self.limits.dchord_mm?)),
+                "dn_mm" => Some(format!("dn +-{} mm", self.limits.dn_mm?)),
+                "rotation_deg" => Some(format!("twist +-{} deg", self.limits.rotation_deg?)),
+                _ => None,
+            })
+            .collect();
+        (!held.is_empty()).then(|| held.join(", "))
+    }
 }
 
 /// A section's best fits, and each of its points' deviation after the least-squares one.
@@ -66,8 +188,12 @@ pub struct SectionFits {
 }
 
 /// The section's fits by least squares and by minimum zone, from its points (part frame, in scan order, flagged
-/// contacts left out); `Err` says why the section could not be fitted.
-pub fn best_fits(gauge: &ProfileGauge, points: &[Point3<f64>]) -> Result<SectionFits, String> {
+/// contacts left out), moving what `settings` lets them; `Err` says why the section could not be fitted.
+pub fn best_fits(
+    gauge: &ProfileGauge,
+    points: &[Point3<f64>],
+    settings: &BestFitSettings,
+) -> Result<SectionFits, String> {
     if points.len() < 4 {
         return Err(format!(
             "{} points are too few for a best fit",
@@ -103,7 +229,12 @@ pub fn best_fits(gauge: &ProfileGauge, points: &[Point3<f64>]) -> Result<Section
     let fits = [(FitMethod::L2, "l2"), (FitMethod::MinZone, "minzone")]
         .into_iter()
         .map(|(method, name)| {
-            let fitted = fit_section(&in_plane, pivot, chord, FitMode::Full, method, measure)
+            let mode = match settings.mode {
+                BestFitMode::Full => FitMode::Full,
+                BestFitMode::Translation => FitMode::Translation,
+            };
+            let limits = settings.limits().fit_limits();
+            let fitted = fit_section(&in_plane, pivot, chord, mode, method, &limits, measure)
                 .map_err(|e| e.to_string())?;
             let across = Vector2::new(-chord.y, chord.x);
             let shift = chord * fitted.dchord_mm + across * fitted.dn_mm;
@@ -111,7 +242,7 @@ pub fn best_fits(gauge: &ProfileGauge, points: &[Point3<f64>]) -> Result<Section
                 after_l2_mm = fitted.after_mm;
             }
             Ok(SectionBestFit {
-                mode: "full".into(),
+                mode: settings.mode.name().into(),
                 method: name.into(),
                 dn_mm: fitted.dn_mm,
                 dchord_mm: fitted.dchord_mm,
@@ -119,6 +250,13 @@ pub fn best_fits(gauge: &ProfileGauge, points: &[Point3<f64>]) -> Result<Section
                 rotation_deg: fitted.rotation_deg,
                 chord_direction: [chord.x, chord.y],
                 form: form(&fitted.form),
+                limits: settings.limits(),
+                at_limit: ["dchord_mm", "dn_mm", "rotation_deg"]
+                    .iter()
+                    .zip(fitted.at_limit)
+                    .filter(|(_, at)| *at)
+                    .map(|(name, _)| name.to_string())
+                    .collect(),
             })
         })
         .collect::<Result<_, String>>()?;

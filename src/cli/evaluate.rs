@@ -8,7 +8,9 @@ use anyhow::{anyhow, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::Vector2;
 
-use crate::analysis::section::{chord_of, nominal_outline, EDGE_DISTANCE_MM};
+use crate::analysis::section::{
+    chord_of, nominal_outline, BestFitLimits, BestFitMode, BestFitSettings, EDGE_DISTANCE_MM,
+};
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
 use crate::geometry::implicit::Implicit;
@@ -34,6 +36,16 @@ pub struct EvaluateArgs {
     /// What the best fit minimises.
     #[arg(long, value_enum, default_value = "l2")]
     method: MethodArg,
+    /// How far (+-) the best fit may move the section along its chord, mm (none: as far as fits best); a section
+    /// lying farther off is fitted to the limit and the rest shows in its form.
+    #[arg(long, value_name = "MM")]
+    max_dchord_mm: Option<f64>,
+    /// How far (+-) the best fit may move the section along its thickness direction, mm.
+    #[arg(long, value_name = "MM")]
+    max_dn_mm: Option<f64>,
+    /// How far (+-) the best fit may turn the section about its chord's middle, deg (with --fit full).
+    #[arg(long, value_name = "DEG")]
+    max_rotation_deg: Option<f64>,
     /// Each point's deviation as measured and after the fit (CSV), if given.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -86,7 +98,20 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         MethodArg::L2 => (FitMethod::L2, "least squares"),
         MethodArg::Minzone => (FitMethod::MinZone, "minimum zone"),
     };
-    let fitted = fit_section(&points, pivot, chord, mode, method, |moved| {
+    let settings = BestFitSettings {
+        mode: match args.fit {
+            FitArg::Translation => BestFitMode::Translation,
+            FitArg::None | FitArg::Full => BestFitMode::Full,
+        },
+        max_dchord_mm: args.max_dchord_mm,
+        max_dn_mm: args.max_dn_mm,
+        max_rotation_deg: args.max_rotation_deg,
+    };
+    settings.check().map_err(|problem| {
+        anyhow!("{problem} (the limits are --max-dchord-mm, --max-dn-mm and --max-rotation-deg)")
+    })?;
+    let limits = settings.limits().fit_limits();
+    let fitted = fit_section(&points, pivot, chord, mode, method, &limits, |moved| {
         exact
             .feet_along_scan(moved)
             .into_iter()
@@ -110,7 +135,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         pivot.x,
         pivot.y
     );
-    print_fit(&fitted, &chord);
+    print_fit(&fitted, &chord, &settings.limits());
     let measured = section_parameters(&points, args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     // The nominal outline: the model's zero set along the points' feet.
@@ -136,7 +161,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>) {
+fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>, limits: &BestFitLimits) {
     let across = Vector2::new(-chord.y, chord.x);
     println!(
         "  chord direction (y, z) ({:.5}, {:.5}); thickness direction, the chord turned +90 deg, ({:.5}, {:.5})",
@@ -147,6 +172,21 @@ fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>) {
          nominal, turned {:+.4} deg (counter-clockwise +)",
         fitted.dn_mm, fitted.dchord_mm, fitted.rotation_deg
     );
+    let held = [
+        ("along the chord", limits.dchord_mm, "mm"),
+        ("along the thickness", limits.dn_mm, "mm"),
+        ("turned", limits.rotation_deg, "deg"),
+    ];
+    for ((what, limit, unit), at) in held.iter().zip(fitted.at_limit) {
+        if let Some(limit) = limit {
+            let state = if at {
+                "reached: the section lies farther off, and the rest shows in the form"
+            } else {
+                "not reached"
+            };
+            println!("  limit {what} +-{limit} {unit}: {state}");
+        }
+    }
     print_form("as measured:  ", &fitted.form_before);
     print_form("after the fit:", &fitted.form);
 }

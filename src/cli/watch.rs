@@ -315,8 +315,12 @@ fn section_line(
     parameters: Option<&SectionParametersReport>,
 ) -> Option<String> {
     let fit = best_fits.iter().find(|f| f.method == "l2").map(|f| {
+        let held = f
+            .held_at()
+            .map(|held| format!(" (the fit held at its limit {held}; the rest is in the form)"))
+            .unwrap_or_default();
         format!(
-            "lies {:+.4} mm along its thickness and {:+.4} mm along its chord, twist {:+.4} deg, form RMS {:.4} mm",
+            "lies {:+.4} mm along its thickness and {:+.4} mm along its chord, twist {:+.4} deg, form RMS {:.4} mm{held}",
             f.dn_mm, f.dchord_mm, f.rotation_deg, f.form.rms_mm
         )
     });

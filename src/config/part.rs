@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{finite, in_reach, parse_toml, read_text, ConfigError, MAX_COORDINATE_MM};
+use crate::analysis::section::BestFitSettings;
 use crate::analysis::tolerances::{Iso484Class, ParameterRules, ParameterTolerances};
 pub use crate::analysis::ReferenceSettings;
 use crate::geometry::poly::MAX_DEGREE;
@@ -34,6 +35,10 @@ pub struct PartConfig {
     /// The reference model fitted to the master's profiles (`kind = "ip"` or `"supershape"`).
     pub reference: ReferenceSettings,
     pub tolerance: ToleranceEntry,
+    /// What each inspected section's best fits may move, and how far (`[best_fit]`; by default the translations and
+    /// the twist, without limits).
+    #[serde(default)]
+    pub best_fit: BestFitSettings,
 }
 
 /// The repeated features of the part: instance k is instance 0 turned `k * step_deg` about the axis.
@@ -185,6 +190,9 @@ impl PartConfig {
             .parameters
             .check()
             .map_err(|problem| format!("[tolerance.parameters] {problem}"))?;
+        self.best_fit
+            .check()
+            .map_err(|problem| format!("[best_fit] {problem}"))?;
         Ok(())
     }
 }
@@ -343,6 +351,8 @@ fn check_reference(reference: &ReferenceSettings) -> Result<(), String> {
 mod tests {
     use super::*;
     use std::path::PathBuf;
+
+    use crate::analysis::section::BestFitMode;
 
     use nalgebra::{Point2, Point3};
     use zeroset_sim::config::{PartSpec, SimConfig};
@@ -560,6 +570,20 @@ mod tests {
 
         let message = refusal(|c| c.tolerance.lower_mm = 0.2);
         assert!(message.contains("must be below upper_mm"), "{message}");
+
+        let message = refusal(|c| c.best_fit.max_dn_mm = Some(-0.1));
+        assert!(
+            message.contains("[best_fit] max_dn_mm = -0.1") && message.contains("leave it out"),
+            "{message}"
+        );
+        let message = refusal(|c| {
+            c.best_fit.mode = BestFitMode::Translation;
+            c.best_fit.max_rotation_deg = Some(0.1);
+        });
+        assert!(
+            message.contains("[best_fit] max_rotation_deg") && message.contains("never turns"),
+            "{message}"
+        );
 
         let message = refusal(|c| c.instances.names.push("A".into()));
         assert!(message.contains("lists \"A\" twice"), "{message}");

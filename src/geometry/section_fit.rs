@@ -22,6 +22,27 @@ pub(crate) enum FitMode {
     Full,
 }
 
+/// How far a fit may move the section, each of the displacements it reports held within +-limit (`None`: free):
+/// blade software's best fit with constraints, where a section may only be moved as far as its position tolerance
+/// allows and what is left counts as form.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct FitLimits {
+    pub dchord_mm: Option<f64>,
+    pub dn_mm: Option<f64>,
+    pub rotation_deg: Option<f64>,
+}
+
+impl FitLimits {
+    /// The bounds of (dchord, dn, rotation in rad).
+    fn bounds(&self) -> [f64; 3] {
+        [
+            self.dchord_mm.unwrap_or(f64::INFINITY),
+            self.dn_mm.unwrap_or(f64::INFINITY),
+            self.rotation_deg.map_or(f64::INFINITY, f64::to_radians),
+        ]
+    }
+}
+
 /// What the fit minimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum FitMethod {
@@ -78,6 +99,8 @@ pub(crate) struct SectionFit {
     pub after_mm: Vec<f64>,
     pub form_before: Form,
     pub form: Form,
+    /// Which of (dchord, dn, rotation) the fit left at its limit: the section lies farther off than it may be moved.
+    pub at_limit: [bool; 3],
 }
 
 /// Why a section could not be fitted.
@@ -104,28 +127,58 @@ const SETTLED_MM: f64 = 1e-6;
 /// A minimum-zone step narrowing the band by less than this (mm) is no step.
 const ZONE_GAIN_MM: f64 = 1e-11;
 
-/// A rigid motion of the section plane: rotate by `angle` about `pivot`, then translate by `shift`.
+/// The fit's unknowns: how the section is displaced from the nominal along the chord and the thickness direction
+/// (mm) and turned about the pivot (rad, counter-clockwise), the quantities reported and limited. A measured point
+/// p is brought onto the nominal by the inverse motion: q = R(-turn) (p - pivot - displacement) + pivot.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Motion {
-    shift: Vector2<f64>,
-    angle: f64,
+struct Placement {
+    /// (dchord, dn, turn).
+    x: Vector3<f64>,
 }
 
-impl Motion {
-    fn apply(&self, pivot: &Vector2<f64>, p: &Vector2<f64>) -> Vector2<f64> {
-        Rotation2::new(self.angle) * (p - pivot) + pivot + self.shift
+impl Placement {
+    fn displacement(&self, along: &Vector2<f64>, across: &Vector2<f64>) -> Vector2<f64> {
+        along * self.x[0] + across * self.x[1]
+    }
+
+    fn apply(
+        &self,
+        pivot: &Vector2<f64>,
+        along: &Vector2<f64>,
+        across: &Vector2<f64>,
+        p: &Vector2<f64>,
+    ) -> Vector2<f64> {
+        Rotation2::new(-self.x[2]) * (p - pivot - self.displacement(along, across)) + pivot
+    }
+
+    /// How q moves with each unknown: d q / d (dchord, dn, turn).
+    fn derivatives(
+        &self,
+        pivot: &Vector2<f64>,
+        along: &Vector2<f64>,
+        across: &Vector2<f64>,
+        p: &Vector2<f64>,
+    ) -> [Vector2<f64>; 3] {
+        let back = Rotation2::new(-self.x[2]);
+        let arm = back * (p - pivot - self.displacement(along, across));
+        [
+            -(back * along),
+            -(back * across),
+            Vector2::new(arm.y, -arm.x),
+        ]
     }
 }
 
 /// Fits the measured `points` to the nominal measured by `measure` (one [`Measured`] per point, `None` where a
-/// point has no foot), rotating about `pivot`; `chord` is the section's chord direction (any length), which the
-/// displacement is reported along.
+/// point has no foot), rotating about `pivot`, each displacement held within `limits`; `chord` is the section's
+/// chord direction (any length), which the displacement is reported along.
 pub(crate) fn fit_section(
     points: &[Vector2<f64>],
     pivot: Vector2<f64>,
     chord: Vector2<f64>,
     mode: FitMode,
     method: FitMethod,
+    limits: &FitLimits,
     measure: impl Fn(&[Vector2<f64>]) -> Vec<Option<Measured>>,
 ) -> Result<SectionFit, SectionFitError> {
     let unknowns = match mode {
@@ -139,19 +192,26 @@ pub(crate) fn fit_section(
             got: points.len(),
         });
     }
-    let measure_all = |motion: &Motion| -> Result<Vec<Measured>, SectionFitError> {
-        let moved: Vec<Vector2<f64>> = points.iter().map(|p| motion.apply(&pivot, p)).collect();
+    let along = chord.try_normalize(0.0).unwrap_or_else(Vector2::x);
+    let across = Vector2::new(-along.y, along.x);
+    // A parameter the mode does not move is held at zero, like one limited to zero.
+    let bound = limits.bounds();
+    let bound = Vector3::from_fn(|k, _| if k < unknowns { bound[k] } else { 0.0 });
+    let measure_all = |placement: &Placement| -> Result<Vec<Measured>, SectionFitError> {
+        let moved: Vec<Vector2<f64>> = points
+            .iter()
+            .map(|p| placement.apply(&pivot, &along, &across, p))
+            .collect();
         measure(&moved)
             .into_iter()
             .enumerate()
             .map(|(index, m)| m.ok_or(SectionFitError::NoFoot { index }))
             .collect()
     };
-    let identity = Motion {
-        shift: Vector2::zeros(),
-        angle: 0.0,
+    let mut placement = Placement {
+        x: Vector3::zeros(),
     };
-    let before: Vec<f64> = measure_all(&identity)?
+    let before: Vec<f64> = measure_all(&placement)?
         .iter()
         .map(|m| m.distance_mm)
         .collect();
@@ -159,10 +219,9 @@ pub(crate) fn fit_section(
         .iter()
         .map(|p| (p - pivot).norm())
         .fold(0.0, f64::max);
-    let mut motion = identity;
-    let mut measured = measure_all(&motion)?;
-    // The minimum zone starts from the least-squares fit: its linear programmes then only refine a motion that is
-    // already close, and the zone they end with can never be wider than least squares' band.
+    let mut measured = measure_all(&placement)?;
+    // The minimum zone starts from the least-squares fit: its linear programmes then only refine a placement that
+    // is already close, and the zone they end with can never be wider than least squares' band.
     let stages: &[FitMethod] = match method {
         FitMethod::L2 => &[FitMethod::L2],
         FitMethod::MinZone => &[FitMethod::L2, FitMethod::MinZone],
@@ -177,38 +236,42 @@ pub(crate) fn fit_section(
             if settled {
                 break;
             }
-            // Each row: how the point's distance changes with (shift x, shift y, angle) of the current motion.
+            // Each row: how the point's distance changes with (dchord, dn, turn) of the current placement.
             let rows: Vec<(f64, Vector3<f64>)> = points
                 .iter()
                 .zip(&measured)
                 .map(|(p, m)| {
-                    let arm = Rotation2::new(motion.angle) * (p - pivot);
-                    let turn = Vector2::new(-arm.y, arm.x);
-                    let row = Vector3::new(m.normal.x, m.normal.y, m.normal.dot(&turn));
+                    let [a, b, turn] = placement.derivatives(&pivot, &along, &across, p);
+                    let row = Vector3::new(m.normal.dot(&a), m.normal.dot(&b), m.normal.dot(&turn));
                     (m.distance_mm, row)
                 })
                 .collect();
+            // The step keeps the placement within its limits.
+            let room = Step {
+                lower: -bound - placement.x,
+                upper: bound - placement.x,
+            };
             let step = match stage {
-                FitMethod::L2 => l2_step(&rows, unknowns),
-                FitMethod::MinZone => minzone_step(&rows, unknowns, trust)?,
+                FitMethod::L2 => l2_step(&rows, &room),
+                FitMethod::MinZone => minzone_step(&rows, &room, trust)?,
             };
             let moved_by = Vector2::new(step.x, step.y).norm() + step.z.abs() * reach;
             // A step counts only if it improves the fit: the linear model is poor where the normals turn fast
             // (a sharp edge, where the distance may switch to the edge's wedge), and where the minimum zone is
             // degenerate (many points on the band at once) its programmes may wander among equal answers. A step
-            // that does not improve is halved until it does; none that does ends the fit.
+            // that does not improve is halved until it does; none that does ends the fit. A halved step stays
+            // within the limits: they bound a box, and the placement and the whole step lie in it.
             let current = objective(stage, &measured);
             let mut trial = step;
             let mut moved = moved_by;
             settled = true;
             for halving in 0..30 {
-                let candidate = Motion {
-                    shift: motion.shift + Vector2::new(trial.x, trial.y),
-                    angle: motion.angle + trial.z,
+                let candidate = Placement {
+                    x: (placement.x + trial).zip_map(&bound, |x, b| x.clamp(-b, b)),
                 };
                 let next = measure_all(&candidate)?;
                 if objective(stage, &next) < current - gain(stage, current) {
-                    motion = candidate;
+                    placement = candidate;
                     measured = next;
                     trust = if halving == 0 { 2.0 * trust } else { moved };
                     settled = moved < SETTLED_MM;
@@ -223,19 +286,31 @@ pub(crate) fn fit_section(
         }
     }
     let after: Vec<f64> = measured.iter().map(|m| m.distance_mm).collect();
-    // The fit maps measured onto nominal: the section itself is displaced by the inverse motion.
-    let displacement = -(Rotation2::new(-motion.angle) * motion.shift);
-    let along = chord.try_normalize(0.0).unwrap_or_else(Vector2::x);
-    let across = Vector2::new(-along.y, along.x);
+    let at_limit = [0, 1, 2].map(|k| {
+        k < unknowns && bound[k].is_finite() && placement.x[k].abs() >= bound[k] * (1.0 - 1e-9)
+    });
     Ok(SectionFit {
-        dchord_mm: displacement.dot(&along),
-        dn_mm: displacement.dot(&across),
-        rotation_deg: -motion.angle.to_degrees(),
+        dchord_mm: placement.x[0],
+        dn_mm: placement.x[1],
+        rotation_deg: placement.x[2].to_degrees(),
         form_before: Form::of(&before),
         form: Form::of(&after),
         before_mm: before,
         after_mm: after,
+        at_limit,
     })
+}
+
+/// The room a step has in each unknown: from `lower` to `upper` (0 to 0 for one the fit does not move).
+struct Step {
+    lower: Vector3<f64>,
+    upper: Vector3<f64>,
+}
+
+impl Step {
+    fn free(&self, k: usize) -> bool {
+        self.lower[k] < self.upper[k]
+    }
 }
 
 /// What a stage minimises: the sum of squared deviations, or the largest absolute one.
@@ -261,32 +336,80 @@ fn current_worst(measured: &[Measured]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The Gauss-Newton step of least squares: minimises the sum of (d + row . step)^2 over the first `unknowns`
-/// parameters (normal equations of at most 3 x 3: the rows are unit normals and lever arms, well conditioned for a
-/// section that is not a circle about the pivot).
-fn l2_step(rows: &[(f64, Vector3<f64>)], unknowns: usize) -> Vector3<f64> {
+/// The Gauss-Newton step of least squares: minimises the sum of (d + row . step)^2 within the step's room. The
+/// problem is a convex quadratic in at most 3 unknowns (normal equations of at most 3 x 3: the rows are unit normals
+/// and lever arms, well conditioned for a section that is not a circle about the pivot), so its bounded minimum is
+/// found exactly by trying each unknown free, at its lower or at its upper bound, and keeping the best of the
+/// answers that lie within the room: the minimum has some such set of active bounds, and for that set it is the
+/// unconstrained minimum of the rest.
+fn l2_step(rows: &[(f64, Vector3<f64>)], room: &Step) -> Vector3<f64> {
     let mut normal = Matrix3::zeros();
-    let mut rhs = Vector3::zeros();
+    let mut gradient = Vector3::zeros();
     for (d, row) in rows {
-        let row = mask(row, unknowns);
         normal += row * row.transpose();
-        rhs -= row * *d;
+        gradient += row * *d;
     }
-    for k in unknowns..3 {
-        normal[(k, k)] = 1.0;
+    let cost = |step: &Vector3<f64>| step.dot(&(normal * step)) + 2.0 * gradient.dot(step);
+    let mut best: Option<(f64, Vector3<f64>)> = None;
+    // Each unknown: 0 free, 1 at its lower bound, 2 at its upper bound; one it does not move sits at 0.
+    for code in 0..27 {
+        let state = [code % 3, code / 3 % 3, code / 9];
+        let mut step = Vector3::zeros();
+        let mut free = Vec::new();
+        let mut possible = true;
+        for k in 0..3 {
+            match (room.free(k), state[k]) {
+                (false, 0) => {}
+                (false, _) => possible = false,
+                (true, 0) => free.push(k),
+                (true, 1) => step[k] = room.lower[k],
+                (true, _) => step[k] = room.upper[k],
+            }
+            possible &= step[k].is_finite();
+        }
+        if !possible {
+            continue;
+        }
+        // The free unknowns minimise with the others held: H_ff s_f = -(g_f + H_fc s_c).
+        let rhs = -(gradient + normal * step);
+        let solved = match free.len() {
+            0 => Some(Vec::new()),
+            _ => {
+                let h = nalgebra::DMatrix::from_fn(free.len(), free.len(), |i, j| {
+                    normal[(free[i], free[j])]
+                });
+                let r = nalgebra::DVector::from_fn(free.len(), |i, _| rhs[free[i]]);
+                h.cholesky().map(|c| c.solve(&r).iter().copied().collect())
+            }
+        };
+        let Some(values) = solved else {
+            continue;
+        };
+        for (k, v) in free.iter().zip(values) {
+            step[*k] = v;
+        }
+        // Within the room, allowing for the rounding of the solve.
+        let slack = |k: usize| 1e-12 * (1.0 + step[k].abs());
+        if (0..3).any(|k| step[k] < room.lower[k] - slack(k) || step[k] > room.upper[k] + slack(k))
+        {
+            continue;
+        }
+        let step = step.zip_zip_map(&room.lower, &room.upper, |s, lo, hi| s.clamp(lo, hi));
+        let value = cost(&step);
+        if best.is_none_or(|(b, _)| value < b) {
+            best = Some((value, step));
+        }
     }
-    normal
-        .cholesky()
-        .map(|c| c.solve(&rhs))
-        .unwrap_or_else(Vector3::zeros)
+    best.map_or_else(Vector3::zeros, |(_, step)| step)
 }
 
 /// The step of the minimum zone: minimises t subject to -t <= d + row . step <= t for every point, a linear
-/// programme in the step and t; the step moves no point by more than `bound` (mm), where the linearisation holds.
+/// programme in the step and t; the step stays within its room and moves no point by more than `trust` (mm),
+/// where the linearisation holds.
 fn minzone_step(
     rows: &[(f64, Vector3<f64>)],
-    unknowns: usize,
-    bound: f64,
+    room: &Step,
+    trust: f64,
 ) -> Result<Vector3<f64>, SectionFitError> {
     use microlp::{ComparisonOp, OptimizationDirection, Problem};
     let mut problem = Problem::new(OptimizationDirection::Minimize);
@@ -295,24 +418,23 @@ fn minzone_step(
         .map(|(_, r)| r.z.abs())
         .fold(0.0, f64::max)
         .max(1e-9);
-    let vars: Vec<_> = (0..unknowns)
+    let vars: Vec<(usize, microlp::Variable)> = (0..3)
+        .filter(|&k| room.free(k))
         .map(|k| {
-            // The angle bound turns the farthest point by about as much as a shift may move it.
-            let b = if k == 2 { bound / reach } else { bound };
-            problem.add_var(0.0, (-b, b))
+            // The turn's trust turns the farthest point by about as much as a shift may move it.
+            let b = if k == 2 { trust / reach } else { trust };
+            let (lo, hi) = (room.lower[k].max(-b), room.upper[k].min(b));
+            (k, problem.add_var(0.0, (lo, hi)))
         })
         .collect();
     let t = problem.add_var(1.0, (0.0, f64::INFINITY));
     for (d, row) in rows {
         let mut upper: Vec<(microlp::Variable, f64)> =
-            vars.iter().enumerate().map(|(k, v)| (*v, row[k])).collect();
+            vars.iter().map(|(k, v)| (*v, row[*k])).collect();
         upper.push((t, -1.0));
         problem.add_constraint(upper.as_slice(), ComparisonOp::Le, -d);
-        let mut lower: Vec<(microlp::Variable, f64)> = vars
-            .iter()
-            .enumerate()
-            .map(|(k, v)| (*v, -row[k]))
-            .collect();
+        let mut lower: Vec<(microlp::Variable, f64)> =
+            vars.iter().map(|(k, v)| (*v, -row[*k])).collect();
         lower.push((t, -1.0));
         problem.add_constraint(lower.as_slice(), ComparisonOp::Le, *d);
     }
@@ -320,14 +442,10 @@ fn minzone_step(
         .solve()
         .map_err(|e| SectionFitError::Programme(e.to_string()))?;
     let mut step = Vector3::zeros();
-    for (k, v) in vars.iter().enumerate() {
-        step[k] = solution[*v];
+    for (k, v) in &vars {
+        step[*k] = solution[*v];
     }
     Ok(step)
-}
-
-fn mask(row: &Vector3<f64>, unknowns: usize) -> Vector3<f64> {
-    Vector3::from_fn(|k, _| if k < unknowns { row[k] } else { 0.0 })
 }
 
 #[cfg(test)]

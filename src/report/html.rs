@@ -137,9 +137,11 @@ fn profile_table(report: &PartReport) -> String {
 /// by least squares and by minimum zone.
 fn best_fit_table(report: &PartReport) -> String {
     let mut html = String::from(
-        "<h2>Sections after a best fit (translations and twist about the chord's middle)</h2>\n<table>\n<tr>\
-         <th>instance</th><th>profile</th><th>method</th><th>along the thickness</th><th>along the chord</th>\
-         <th>shift (y, z)</th><th>twist</th><th>form min</th><th>form max</th><th>form RMS</th><th>zone</th></tr>\n",
+        "<h2>Sections after a best fit (the translations, and in mode full the twist about the chord's middle)</h2>\
+         \n<table>\n<tr><th>instance</th><th>profile</th><th>mode</th>\
+         <th>method</th><th>along the thickness</th><th>along the chord</th>\
+         <th>shift (y, z)</th><th>twist</th><th>form min</th><th>form max</th><th>form RMS</th><th>zone</th>\
+         <th>held at its limit</th></tr>\n",
     );
     for instance in &report.instances {
         for profile in &instance.profiles {
@@ -148,6 +150,7 @@ fn best_fit_table(report: &PartReport) -> String {
                 let cells = [
                     escape(&instance.name),
                     escape(&profile.name),
+                    escape(&fit.mode),
                     escape(&fit.method),
                     deviation_mm(fit.dn_mm),
                     deviation_mm(fit.dchord_mm),
@@ -160,6 +163,7 @@ fn best_fit_table(report: &PartReport) -> String {
                     deviation_mm(f.max_mm),
                     format!("{:.DEVIATION_DECIMALS$} mm", f.rms_mm),
                     format!("{:.DEVIATION_DECIMALS$} mm", f.zone_mm),
+                    escape(&fit.held_at().unwrap_or_default()),
                 ];
                 html.push_str(&cells_row(cells));
             }

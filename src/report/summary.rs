@@ -209,12 +209,27 @@ fn sections_text(report: &PartReport) -> String {
     if rows.len() == 1 {
         return String::new();
     }
+    let held: String = report
+        .instances
+        .iter()
+        .flat_map(|instance| {
+            instance.profiles.iter().flat_map(move |profile| {
+                profile.best_fits.iter().filter_map(move |fit| {
+                    let held = fit.held_at()?;
+                    Some(format!(
+                        "{} {}: the {} fit held at its limit {held} ([best_fit]); the rest is in its form\n",
+                        instance.name, profile.name, fit.method
+                    ))
+                })
+            })
+        })
+        .collect();
     format!(
         "\nsections: least-squares best fit (dn along the thickness, + above; dchord along the chord; twist \
          counter-clockwise in y, z) and parameters minus nominal (thickness: largest inscribed circle; le, te: edge \
          thicknesses; pitch in % of nominal)\n{}",
         table(&rows, &[0, 1, 12])
-    )
+    ) + &held
 }
 
 /// A pitch's deviation in percent of its nominal, e.g. "+0.213".

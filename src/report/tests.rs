@@ -267,6 +267,8 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
             rms_mm: 0.0021,
             zone_mm: 0.008,
         },
+        limits: Default::default(),
+        at_limit: Vec::new(),
     };
     profile.best_fits = vec![fit("l2", -0.4012), fit("minzone", -0.3990)];
     profile.parameters = Some(sample_parameters());
@@ -279,6 +281,18 @@ fn the_summary_says_where_each_fitted_section_lies_and_how_far_its_parameters_ar
             "-0.0134", "-0.0039", "-0.0293", "-0.142"
         ],
         "least squares, not the minimum zone: {line}"
+    );
+    assert!(!text.contains("held at its limit"), "{text}");
+    // A fit the part file's [best_fit] held at a limit says so below the table, naming the section and the limit.
+    let minzone = &mut report.instances[1].profiles[0].best_fits[1];
+    minzone.limits.dn_mm = Some(0.25);
+    minzone.at_limit = vec!["dn_mm".into()];
+    let text = summary_text(&report);
+    assert!(
+        text.contains(
+            "blade-B p100: the minzone fit held at its limit dn +-0.25 mm ([best_fit]); the rest is in its form"
+        ),
+        "{text}"
     );
 }
 

@@ -254,7 +254,11 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let summary = stats
                 .summary()
                 .ok_or_else(|| format!("{}: the scan has no points", plan.describe(key)))?;
-            let best_fits = match section::best_fits(&inputs.gauges[key.profile], &in_part) {
+            let best_fits = match section::best_fits(
+                &inputs.gauges[key.profile],
+                &in_part,
+                plan.best_fit(),
+            ) {
                 Ok(fitted) => {
                     let unflagged = points.iter_mut().filter(|p| !p.flagged);
                     for (point, after) in unflagged.zip(fitted.after_l2_mm) {

@@ -236,10 +236,11 @@ impl Pipeline {
         );
         let radius = self.plan.profile_radius(key.profile);
         let tolerances = self.plan.tolerance().parameter_tolerances();
+        let fit_settings = *self.plan.best_fit();
         let described = self.plan.describe(key);
         tokio::task::spawn_blocking(move || {
             let gauge = &gauges[key.profile];
-            let best_fits = section::best_fits(gauge, &in_part)
+            let best_fits = section::best_fits(gauge, &in_part, &fit_settings)
                 .map(|f| f.fits)
                 .unwrap_or_else(|problem| {
                     tracing::warn!(scan = %described, %problem, "live: no best fit of the section");

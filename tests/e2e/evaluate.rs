@@ -1,7 +1,9 @@
 //! `zeroset evaluate`: a section moved rigidly off its nominal reads back as that motion, and its form as the
 //! noise left once the motion is removed; the minimum zone is never wider than least squares'.
 
-use crate::support::{config, fit_ip, zeroset_ok};
+use std::path::{Path, PathBuf};
+
+use crate::support::{config, fit_ip, zeroset, zeroset_ok};
 
 /// The numbers of `line` after `marker`, up to `count`.
 fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
@@ -16,13 +18,12 @@ fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("a.json");
+/// The master blade's profile 3 fitted into `dir`/a.json, and its own points 0.4 mm lower and 0.05 mm to +y (what
+/// a blade shifted on the hub would measure) in `dir`/moved.csv: the model, the moved section, the master's text.
+fn master_and_moved(dir: &Path) -> (PathBuf, PathBuf, String) {
+    let model = dir.join("a.json");
     let blade = config("profiles/seed003-profile3-blade-a.csv");
     fit_ip(&blade, &[], &model);
-    // The master's own points, 0.4 mm lower and 0.05 mm to +y: what a blade shifted on the hub would measure.
     let text = std::fs::read_to_string(&blade).unwrap();
     let mut moved = String::from("y,z\n");
     for line in text.lines().skip(1) {
@@ -30,8 +31,15 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
         let (y, z): (f64, f64) = (y.parse().unwrap(), z.parse().unwrap());
         moved.push_str(&format!("{},{}\n", y + 0.05, z - 0.4));
     }
-    let section = dir.path().join("moved.csv");
+    let section = dir.join("moved.csv");
     std::fs::write(&section, moved).unwrap();
+    (model, section, text)
+}
+
+#[test]
+fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, section, text) = master_and_moved(dir.path());
     let mut zones = Vec::new();
     for method in ["l2", "minzone"] {
         let out = dir.path().join(format!("{method}.csv"));
@@ -140,5 +148,68 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
         "minimum zone {} mm, L2 {} mm",
         zones[1],
         zones[0]
+    );
+}
+
+#[test]
+fn a_fit_held_within_a_limit_stops_there_says_so_and_keeps_the_rest_in_the_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, section, _) = master_and_moved(dir.path());
+    let (model, section) = (model.to_str().unwrap(), section.to_str().unwrap());
+    for method in ["l2", "minzone"] {
+        let printed = zeroset_ok(&[
+            "evaluate",
+            "--model",
+            model,
+            "--points",
+            section,
+            "--method",
+            method,
+            "--max-dn-mm",
+            "0.25",
+            "--max-rotation-deg",
+            "0.5",
+        ]);
+        // Where the motion puts the section along its thickness direction (the chord turned +90 deg): farther off
+        // than 0.25 mm, so the fit is held there.
+        let chord = numbers_after(&printed, "chord direction (y, z)", 2);
+        let made = 0.05 * -chord[1] + -0.4 * chord[0];
+        assert!(made.abs() > 0.3, "{made}");
+        let dn = numbers_after(&printed, "the section lies", 1)[0];
+        assert!(
+            (dn - 0.25 * made.signum()).abs() < 1e-9,
+            "{method}: {dn}\n{printed}"
+        );
+        assert!(
+            printed.contains("limit along the thickness +-0.25 mm: reached")
+                && printed.contains("limit turned +-0.5 deg: not reached"),
+            "{method}:\n{printed}"
+        );
+        // What the fit could not take stays in the form, on both faces: a band about twice as wide.
+        let after = numbers_after(&printed, "after the fit:", 4);
+        let rest = made.abs() - 0.25;
+        assert!(
+            after[3] > 1.5 * rest,
+            "{method}: zone {} mm for {rest} mm left\n{printed}",
+            after[3]
+        );
+    }
+    let refused = zeroset(&[
+        "evaluate",
+        "--model",
+        model,
+        "--points",
+        section,
+        "--fit",
+        "translation",
+        "--max-rotation-deg",
+        "0.1",
+    ]);
+    assert!(
+        !refused.success
+            && refused.stderr.contains("max_rotation_deg")
+            && refused.stderr.contains("--max-rotation-deg"),
+        "{}",
+        refused.stderr
     );
 }

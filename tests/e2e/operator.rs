@@ -105,7 +105,8 @@ fn with_stdout_closed(
 
 /// config/parts/propeller.toml in `dir` with its tolerance band set to `lower_mm .. upper_mm`.
 fn propeller_part(dir: &Path, lower_mm: f64, upper_mm: f64) {
-    propeller_part_edited(dir, |tolerance| {
+    propeller_part_edited(dir, |part| {
+        let tolerance = part["tolerance"].as_table_mut().unwrap();
         tolerance.insert("lower_mm".into(), lower_mm.into());
         tolerance.insert("upper_mm".into(), upper_mm.into());
     });

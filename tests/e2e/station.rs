@@ -220,7 +220,8 @@ fn assert_best_fits_recover_the_blade_errors(
 #[test]
 fn inspect_reads_back_blades_of_the_wrong_thickness_chord_and_camber_and_judges_them() {
     let parts = tempfile::tempdir().unwrap();
-    propeller_part_edited(parts.path(), |tolerance| {
+    propeller_part_edited(parts.path(), |part| {
+        let tolerance = part["tolerance"].as_table_mut().unwrap();
         tolerance.insert("lower_mm".into(), (-1.0).into());
         tolerance.insert("upper_mm".into(), 1.0.into());
         let parameters = tolerance["parameters"].as_table_mut().unwrap();
@@ -938,4 +939,88 @@ fn without_a_daemon_the_cli_says_how_to_start_one() {
     let run = crate::support::zeroset(&["status", "--config", &file.display().to_string()]);
     assert!(!run.success);
     assert!(run.stderr.contains("zeroset daemon"), "{}", run.stderr);
+}
+
+/// A part file's `[best_fit]` limit holds the station's section fits: blade B lies 0.4 to 1.0 mm below A along the
+/// hub axis (seed 003's figure), so with `max_dn_mm = 0.5` every section the simulator put farther than 0.5 mm off
+/// along its thickness is fitted to the limit, says so live, in report.json and in summary.txt, and keeps the rest
+/// in its form; every other section is fitted where it lies, as without the limit.
+#[test]
+fn a_best_fit_limit_in_the_part_file_holds_the_section_fits_and_says_so() {
+    const LIMIT_MM: f64 = 0.5;
+    let parts = tempfile::tempdir().unwrap();
+    propeller_part_edited(parts.path(), |part| {
+        let mut best_fit = toml::Table::new();
+        best_fit.insert("mode".into(), "full".into());
+        best_fit.insert("max_dn_mm".into(), LIMIT_MM.into());
+        part.insert("best_fit".into(), best_fit.into());
+    });
+    let folder = parts.path().display().to_string();
+    let station = Station::start_edited("propeller.toml", "station.toml", |table| {
+        table.insert("parts".into(), folder.into());
+    })
+    .with_taught_reference();
+    let watch = station.spawn(&["watch"]);
+    station.inspected(&["inspect", "propeller", "--serial", "SN-HELD"]);
+    let watched = watch.wait_with_output().expect("watch ends with the job");
+    let watched = String::from_utf8_lossy(&watched.stdout);
+    let (dir, report) = station.report("SN-HELD");
+    let summary = std::fs::read_to_string(dir.join("summary.txt")).unwrap();
+    let spec = propeller_spec("propeller.toml");
+    let (mut held, mut free) = (0, 0);
+    for (k, instance) in report.instances.iter().enumerate() {
+        for profile in &instance.profiles {
+            let what = format!("{} {}", instance.name, profile.name);
+            let r: f64 = profile.name.trim_start_matches('r').parse().unwrap();
+            let made = injected(&spec, k, r);
+            assert_eq!(profile.best_fits.len(), 2, "{what}");
+            for fit in &profile.best_fits {
+                assert_eq!(fit.limits.dn_mm, Some(LIMIT_MM), "{what}");
+                // Where the simulator put the section along its thickness direction (the chord turned +90 deg).
+                let across = [-fit.chord_direction[1], fit.chord_direction[0]];
+                let dn = made.shift_mm[0] * across[0] + made.shift_mm[1] * across[1];
+                let line = format!(
+                    "{what}: the {} fit held at its limit dn +-{LIMIT_MM} mm",
+                    fit.method
+                );
+                if dn.abs() > LIMIT_MM + 0.01 {
+                    held += 1;
+                    assert_eq!(fit.at_limit, ["dn_mm"], "{what} {}: made {dn}", fit.method);
+                    assert!((fit.dn_mm - LIMIT_MM * dn.signum()).abs() < 1e-9, "{what}");
+                    // What the fit could not take stays in the form: the faces lie |dn| - 0.5 mm off.
+                    assert!(
+                        fit.form.zone_mm > 1.5 * (dn.abs() - LIMIT_MM),
+                        "{what} {}: made {dn}, {:?}",
+                        fit.method,
+                        fit.form
+                    );
+                    assert!(summary.contains(&line), "{line}\n{summary}");
+                } else if dn.abs() < LIMIT_MM - 0.01 {
+                    free += 1;
+                    assert!(fit.at_limit.is_empty(), "{what}: made {dn}, {fit:?}");
+                    // Least squares reads the place within the 3 um; the minimum zone is set by the
+                    // section's few extreme points (the sharp edge's among them), not by where it lies.
+                    assert!(
+                        fit.dn_mm.abs() < LIMIT_MM,
+                        "{what} {}: {}",
+                        fit.method,
+                        fit.dn_mm
+                    );
+                    if fit.method == "l2" {
+                        assert!(
+                            (fit.dn_mm - dn).abs() < 0.003,
+                            "{what}: {} made {dn}",
+                            fit.dn_mm
+                        );
+                    }
+                    assert!(!summary.contains(&line), "{line}\n{summary}");
+                }
+            }
+        }
+    }
+    assert!(held >= 4 && free >= 10, "held {held}, free {free}");
+    assert!(
+        watched.contains("(the fit held at its limit dn +-0.5 mm; the rest is in the form)"),
+        "{watched}"
+    );
 }

@@ -11,12 +11,12 @@ pub fn config(relative: &str) -> String {
     repo().join("config").join(relative).display().to_string()
 }
 
-/// config/parts/propeller.toml written into `dir` with its `[tolerance]` table changed by `edit`, for a station
+/// config/parts/propeller.toml written into `dir` as changed by `edit` (the whole part table), for a station
 /// whose `parts` folder is `dir`.
 pub fn propeller_part_edited(dir: &Path, edit: impl FnOnce(&mut toml::Table)) {
     let text = std::fs::read_to_string(repo().join("config/parts/propeller.toml")).unwrap();
     let mut table: toml::Table = toml::from_str(&text).unwrap();
-    edit(table["tolerance"].as_table_mut().unwrap());
+    edit(&mut table);
     std::fs::write(dir.join("propeller.toml"), toml::to_string(&table).unwrap()).unwrap();
 }
 

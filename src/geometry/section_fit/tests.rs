@@ -83,12 +83,23 @@ fn displaced(points: &[Vector2<f64>], shift: Vector2<f64>, angle_deg: f64) -> Ve
 }
 
 fn fit(nominal: &Polygon, points: &[Vector2<f64>], mode: FitMode, method: FitMethod) -> SectionFit {
+    fit_within(nominal, points, mode, method, &FitLimits::default())
+}
+
+fn fit_within(
+    nominal: &Polygon,
+    points: &[Vector2<f64>],
+    mode: FitMode,
+    method: FitMethod,
+    limits: &FitLimits,
+) -> SectionFit {
     fit_section(
         points,
         Vector2::zeros(),
         Vector2::x(),
         mode,
         method,
+        limits,
         |moved| moved.iter().map(|p| Some(nominal.measure(p))).collect(),
     )
     .unwrap()
@@ -190,4 +201,130 @@ fn the_minimum_zone_is_never_wider_than_the_least_squares_band() {
         // Both see the same displacement, within what the noise allows.
         assert!((l2.dn_mm + 0.1).abs() < 5e-4 && (zone.dn_mm + 0.1).abs() < 2e-3);
     }
+}
+
+#[test]
+fn a_fit_held_within_a_limit_stops_at_it_and_leaves_the_rest_in_the_form() {
+    let nominal = Polygon::blade();
+    let (shift, angle) = (Vector2::new(0.3, 0.4), 0.1);
+    let measured = displaced(&nominal.section(|_| 0.0), shift, angle);
+    let limits = FitLimits {
+        dn_mm: Some(0.25),
+        ..FitLimits::default()
+    };
+    for method in [FitMethod::L2, FitMethod::MinZone] {
+        let held = fit_within(&nominal, &measured, FitMode::Full, method, &limits);
+        assert_eq!(held.dn_mm, 0.25, "{method:?}");
+        assert_eq!(held.at_limit, [false, true, false], "{method:?}");
+        // The 0.15 mm the fit may not take stays as form: the faces 12 mm apart lie 0.15 mm up, so the band
+        // about the nominal is some 0.3 mm wide.
+        assert!(
+            (held.form.zone_mm - 0.3).abs() < 0.01,
+            "{method:?}: {:?}",
+            held.form
+        );
+        // Held at 0.25 is the same as moved back by 0.25 first and held at 0: the same twist, shift and form.
+        let back = Vector2::new(0.0, 0.25);
+        let moved_back: Vec<Vector2<f64>> = measured.iter().map(|p| p - back).collect();
+        let fixed = FitLimits {
+            dn_mm: Some(0.0),
+            ..FitLimits::default()
+        };
+        let pinned = fit_within(&nominal, &moved_back, FitMode::Full, method, &fixed);
+        assert_eq!(pinned.dn_mm, 0.0);
+        assert!(
+            // Both settle once a step moves no point by a nanometre.
+            (pinned.dchord_mm - held.dchord_mm).abs() < 1e-6
+                && (pinned.rotation_deg - held.rotation_deg).abs() < 1e-6
+                && (pinned.form.zone_mm - held.form.zone_mm).abs() < 1e-6,
+            "{method:?}: held {:?} / pinned {:?}",
+            (held.dchord_mm, held.rotation_deg, held.form),
+            (pinned.dchord_mm, pinned.rotation_deg, pinned.form)
+        );
+        // Limits the motion does not reach change nothing.
+        let loose = FitLimits {
+            dchord_mm: Some(1.0),
+            dn_mm: Some(1.0),
+            rotation_deg: Some(1.0),
+        };
+        let free = fit(&nominal, &measured, FitMode::Full, method);
+        let within = fit_within(&nominal, &measured, FitMode::Full, method, &loose);
+        assert_eq!(within.at_limit, [false; 3]);
+        assert!(
+            (within.dn_mm - free.dn_mm).abs() < 1e-6
+                && (within.dchord_mm - free.dchord_mm).abs() < 1e-6
+                && (within.rotation_deg - free.rotation_deg).abs() < 1e-6,
+            "{method:?}"
+        );
+        assert!((free.dn_mm - 0.4).abs() < 1e-6 && (free.rotation_deg - angle).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn a_twist_limited_to_zero_is_the_translation_fit() {
+    let nominal = Polygon::blade();
+    let measured = displaced(&nominal.section(|_| 0.0), Vector2::new(-0.2, 0.1), 0.05);
+    let no_turn = FitLimits {
+        rotation_deg: Some(0.0),
+        ..FitLimits::default()
+    };
+    for method in [FitMethod::L2, FitMethod::MinZone] {
+        let limited = fit_within(&nominal, &measured, FitMode::Full, method, &no_turn);
+        let translated = fit(&nominal, &measured, FitMode::Translation, method);
+        assert_eq!(limited.rotation_deg, 0.0);
+        assert_eq!(limited.at_limit, [false, false, true]);
+        assert!(
+            (limited.dn_mm - translated.dn_mm).abs() < 1e-6
+                && (limited.dchord_mm - translated.dchord_mm).abs() < 1e-6
+                && (limited.form.zone_mm - translated.form.zone_mm).abs() < 1e-6,
+            "{method:?}: {:?} / {:?}",
+            (limited.dn_mm, limited.dchord_mm, limited.form),
+            (translated.dn_mm, translated.dchord_mm, translated.form)
+        );
+    }
+}
+
+#[test]
+fn the_bounded_least_squares_step_meets_the_optimality_conditions() {
+    // A convex quadratic within a box is at its minimum exactly where each unknown strictly inside its bounds has
+    // a zero gradient, one at its lower bound a gradient >= 0 and one at its upper bound a gradient <= 0 (KKT).
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let mut active = 0;
+    for _ in 0..500 {
+        let rows: Vec<(f64, Vector3<f64>)> = (0..8)
+            .map(|_| {
+                let row = Vector3::from_fn(|_, _| rng.gen_range(-1.0..1.0));
+                (rng.gen_range(-1.0..1.0), row)
+            })
+            .collect();
+        let bound = |rng: &mut rand::rngs::StdRng| match rng.gen_range(0..4) {
+            0 => f64::INFINITY,
+            1 => 0.0,
+            _ => rng.gen_range(0.01..0.5),
+        };
+        let lower = Vector3::from_fn(|_, _| -bound(&mut rng));
+        let upper = Vector3::from_fn(|_, _| bound(&mut rng));
+        let room = Step { lower, upper };
+        let step = l2_step(&rows, &room);
+        let gradient: Vector3<f64> = rows.iter().map(|(d, row)| row * (d + row.dot(&step))).sum();
+        for k in 0..3 {
+            assert!(
+                lower[k] <= step[k] && step[k] <= upper[k],
+                "{step} in {lower}..{upper}"
+            );
+            if !room.free(k) {
+                continue;
+            }
+            let at_lower = step[k] <= lower[k] + 1e-12;
+            let at_upper = step[k] >= upper[k] - 1e-12;
+            active += usize::from(at_lower || at_upper);
+            let g = gradient[k];
+            let fine = (at_lower && g >= -1e-9) || (at_upper && g <= 1e-9) || g.abs() < 1e-9;
+            assert!(
+                fine,
+                "unknown {k}: step {step}, gradient {gradient}, room {lower}..{upper}"
+            );
+        }
+    }
+    assert!(active > 100, "the bounds were reached {active} times");
 }
