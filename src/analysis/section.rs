@@ -50,6 +50,8 @@ pub enum BestFitMode {
     Full,
     /// The two translations only: a twist stays in the form.
     Translation,
+    /// Nothing: the section as measured, its form its deviations.
+    None,
 }
 
 impl BestFitMode {
@@ -57,6 +59,15 @@ impl BestFitMode {
         match self {
             Self::Full => "full",
             Self::Translation => "translation",
+            Self::None => "none",
+        }
+    }
+
+    pub(crate) fn fit_mode(self) -> FitMode {
+        match self {
+            Self::Full => FitMode::Full,
+            Self::Translation => FitMode::Translation,
+            Self::None => FitMode::None,
         }
     }
 }
@@ -111,6 +122,14 @@ impl BestFitSettings {
                     ));
                 }
             }
+        }
+        let limited = self.limits() != BestFitLimits::default();
+        if self.mode == BestFitMode::None && limited {
+            return Err(
+                "limits are given but mode = \"none\" moves no section; leave them out, or set mode = \
+                 \"full\" or \"translation\""
+                    .into(),
+            );
         }
         if self.mode == BestFitMode::Translation && self.max_rotation_deg.is_some() {
             return Err(
@@ -229,10 +248,7 @@ pub fn best_fits(
     let fits = [(FitMethod::L2, "l2"), (FitMethod::MinZone, "minzone")]
         .into_iter()
         .map(|(method, name)| {
-            let mode = match settings.mode {
-                BestFitMode::Full => FitMode::Full,
-                BestFitMode::Translation => FitMode::Translation,
-            };
+            let mode = settings.mode.fit_mode();
             let limits = settings.limits().fit_limits();
             let fitted = fit_section(&in_plane, pivot, chord, mode, method, &limits, measure)
                 .map_err(|e| e.to_string())?;

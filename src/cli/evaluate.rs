@@ -15,7 +15,7 @@ use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::ZeroSetSamples;
-use crate::geometry::section_fit::{fit_section, FitMethod, FitMode, Form, Measured, SectionFit};
+use crate::geometry::section_fit::{fit_section, FitMethod, Form, Measured, SectionFit};
 use crate::geometry::section_parameters::{section_parameters, SectionParameters};
 use crate::model_file::{ModelFile, ReferenceModel};
 use crate::points::{read_points, PointSet};
@@ -90,19 +90,16 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     let samples = ZeroSetSamples::new(&model.ip, &model.domain.scaled(2.0), CELLS);
     let exact = ExactDistance::new(&model.ip, &samples);
     let (mode, mode_name) = match args.fit {
-        FitArg::None => (FitMode::None, "no fit"),
-        FitArg::Translation => (FitMode::Translation, "translations"),
-        FitArg::Full => (FitMode::Full, "translations and rotation"),
+        FitArg::None => (BestFitMode::None, "no fit"),
+        FitArg::Translation => (BestFitMode::Translation, "translations"),
+        FitArg::Full => (BestFitMode::Full, "translations and rotation"),
     };
     let (method, method_name) = match args.method {
         MethodArg::L2 => (FitMethod::L2, "least squares"),
         MethodArg::Minzone => (FitMethod::MinZone, "minimum zone"),
     };
     let settings = BestFitSettings {
-        mode: match args.fit {
-            FitArg::Translation => BestFitMode::Translation,
-            FitArg::None | FitArg::Full => BestFitMode::Full,
-        },
+        mode,
         max_dchord_mm: args.max_dchord_mm,
         max_dn_mm: args.max_dn_mm,
         max_rotation_deg: args.max_rotation_deg,
@@ -111,20 +108,28 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         anyhow!("{problem} (the limits are --max-dchord-mm, --max-dn-mm and --max-rotation-deg)")
     })?;
     let limits = settings.limits().fit_limits();
-    let fitted = fit_section(&points, pivot, chord, mode, method, &limits, |moved| {
-        exact
-            .feet_along_scan(moved)
-            .into_iter()
-            .map(|foot| {
-                let foot = foot.ok()?;
-                let (_, gradient) = model.ip.value_gradient(&foot.point);
-                Some(Measured {
-                    distance_mm: foot.distance,
-                    normal: gradient.try_normalize(0.0)?,
+    let fitted = fit_section(
+        &points,
+        pivot,
+        chord,
+        mode.fit_mode(),
+        method,
+        &limits,
+        |moved| {
+            exact
+                .feet_along_scan(moved)
+                .into_iter()
+                .map(|foot| {
+                    let foot = foot.ok()?;
+                    let (_, gradient) = model.ip.value_gradient(&foot.point);
+                    Some(Measured {
+                        distance_mm: foot.distance,
+                        normal: gradient.try_normalize(0.0)?,
+                    })
                 })
-            })
-            .collect()
-    })
+                .collect()
+        },
+    )
     .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     println!(
         "section {} ({} points) against {}; best fit: {mode_name} by {method_name}, about the chord's middle \

@@ -577,6 +577,14 @@ mod tests {
             "{message}"
         );
         let message = refusal(|c| {
+            c.best_fit.mode = BestFitMode::None;
+            c.best_fit.max_dchord_mm = Some(0.1);
+        });
+        assert!(
+            message.contains("[best_fit] limits are given but mode = \"none\""),
+            "{message}"
+        );
+        let message = refusal(|c| {
             c.best_fit.mode = BestFitMode::Translation;
             c.best_fit.max_rotation_deg = Some(0.1);
         });

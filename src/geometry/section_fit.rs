@@ -286,8 +286,14 @@ pub(crate) fn fit_section(
         }
     }
     let after: Vec<f64> = measured.iter().map(|m| m.distance_mm).collect();
+    // At a limit: within what a settled step may still move it (a nanometre; for the turn, a nanometre at the
+    // farthest point). A limit of zero pins its parameter by the part file's choice and is not reported as reached.
+    let settled_within = [SETTLED_MM, SETTLED_MM, SETTLED_MM / reach.max(1e-9)];
     let at_limit = [0, 1, 2].map(|k| {
-        k < unknowns && bound[k].is_finite() && placement.x[k].abs() >= bound[k] * (1.0 - 1e-9)
+        k < unknowns
+            && bound[k].is_finite()
+            && bound[k] > 0.0
+            && bound[k] - placement.x[k].abs() <= settled_within[k]
     });
     Ok(SectionFit {
         dchord_mm: placement.x[0],
@@ -350,7 +356,9 @@ fn l2_step(rows: &[(f64, Vector3<f64>)], room: &Step) -> Vector3<f64> {
         gradient += row * *d;
     }
     let cost = |step: &Vector3<f64>| step.dot(&(normal * step)) + 2.0 * gradient.dot(step);
-    let mut best: Option<(f64, Vector3<f64>)> = None;
+    // Not moving is always within the room (the placement is within its limits), and it costs nothing: no step
+    // may be worse, even where a singular free set leaves the true minimum unsolved.
+    let mut best = (0.0, Vector3::zeros());
     // Each unknown: 0 free, 1 at its lower bound, 2 at its upper bound; one it does not move sits at 0.
     for code in 0..27 {
         let state = [code % 3, code / 3 % 3, code / 9];
@@ -396,11 +404,11 @@ fn l2_step(rows: &[(f64, Vector3<f64>)], room: &Step) -> Vector3<f64> {
         }
         let step = step.zip_zip_map(&room.lower, &room.upper, |s, lo, hi| s.clamp(lo, hi));
         let value = cost(&step);
-        if best.is_none_or(|(b, _)| value < b) {
-            best = Some((value, step));
+        if value < best.0 {
+            best = (value, step);
         }
     }
-    best.map_or_else(Vector3::zeros, |(_, step)| step)
+    best.1
 }
 
 /// The step of the minimum zone: minimises t subject to -t <= d + row . step <= t for every point, a linear

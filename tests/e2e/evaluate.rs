@@ -177,7 +177,7 @@ fn a_fit_held_within_a_limit_stops_there_says_so_and_keeps_the_rest_in_the_form(
         assert!(made.abs() > 0.3, "{made}");
         let dn = numbers_after(&printed, "the section lies", 1)[0];
         assert!(
-            (dn - 0.25 * made.signum()).abs() < 1e-9,
+            (dn - 0.25 * made.signum()).abs() < 1e-4, // printed to 0.1 um
             "{method}: {dn}\n{printed}"
         );
         assert!(

@@ -295,9 +295,10 @@ pub fn ptmeas(
 }
 
 /// How many of a scan's `count` points are measured before an armed `no-touch` fault loses the touch: the first
-/// half. The machine stops where it last touched, the points it measured sent, then 1003.
+/// half (none of a scan of one point). The machine stops where it last touched, the points it measured sent, then
+/// 1003.
 fn touch_lost_after(count: usize) -> usize {
-    count.div_ceil(2)
+    count / 2
 }
 
 /// The probing at a scan's start: approach, search, and the contact, or the error to report.
@@ -422,12 +423,19 @@ pub fn scan_on_curve(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
     if std::mem::take(&mut world.armed.surface_not_found) {
         return timeline.fail(code::SURFACE_NOT_FOUND);
     }
-    let touch_lost = std::mem::take(&mut world.armed.no_touch);
+    // An armed no-touch fires once the first half of the points to measure are measured, the probe at the last
+    // of them (at the approach when there are none to keep); it is taken only when it fires, so a scan that fails
+    // before leaves it armed for the next.
+    let keep = world.armed.no_touch.then(|| {
+        let to_measure = nominals.iter().filter(|n| n.on_surface).count();
+        touch_lost_after(to_measure)
+    });
     let mut path = vec![approach];
     let mut measured = Vec::new();
     let mut failed = None;
-    for (index, nominal) in nominals.iter().enumerate() {
-        if touch_lost && index == touch_lost_after(nominals.len()) {
+    for nominal in &nominals {
+        if keep == Some(measured.len()) {
+            world.armed.no_touch = false;
             failed = Some(code::NO_TOUCH);
             break;
         }

@@ -299,7 +299,7 @@ fn a_scan_that_loses_its_touch_sends_its_first_half_then_1003_and_stops_where_it
         let error = error.unwrap_or_else(|| panic!("{what}: {lost:?}"));
         assert!(error.contains(", 1003, "), "{what}: {error}");
         assert_eq!(bench.controller.armed(), Armed::default(), "{what}");
-        assert_eq!(half.len(), all.len().div_ceil(2), "{what}");
+        assert_eq!(half.len(), all.len() / 2, "{what}");
         for (a, b) in half.iter().zip(&all) {
             assert!((a - b).norm() < 0.05, "{what}: {a} against {b}");
         }

@@ -214,7 +214,12 @@ fn a_fit_held_within_a_limit_stops_at_it_and_leaves_the_rest_in_the_form() {
     };
     for method in [FitMethod::L2, FitMethod::MinZone] {
         let held = fit_within(&nominal, &measured, FitMode::Full, method, &limits);
-        assert_eq!(held.dn_mm, 0.25, "{method:?}");
+        // Held at the limit, within what a settled step may still move (a nanometre).
+        assert!(
+            (held.dn_mm - 0.25).abs() <= 1e-6,
+            "{method:?}: {}",
+            held.dn_mm
+        );
         assert_eq!(held.at_limit, [false, true, false], "{method:?}");
         // The 0.15 mm the fit may not take stays as form: the faces 12 mm apart lie 0.15 mm up, so the band
         // about the nominal is some 0.3 mm wide.
@@ -272,7 +277,8 @@ fn a_twist_limited_to_zero_is_the_translation_fit() {
         let limited = fit_within(&nominal, &measured, FitMode::Full, method, &no_turn);
         let translated = fit(&nominal, &measured, FitMode::Translation, method);
         assert_eq!(limited.rotation_deg, 0.0);
-        assert_eq!(limited.at_limit, [false, false, true]);
+        // A limit of zero pins the twist by choice: it is not reported as reached.
+        assert_eq!(limited.at_limit, [false; 3]);
         assert!(
             (limited.dn_mm - translated.dn_mm).abs() < 1e-6
                 && (limited.dchord_mm - translated.dchord_mm).abs() < 1e-6
