@@ -44,8 +44,10 @@ impl Tally {
     }
 
     pub(crate) fn refused(&mut self, message: &str) {
-        // Tags and numbers vary from one refusal to the next; the first 100 characters name the cause.
-        let key: String = message.trim().chars().take(100).collect();
+        // Positions vary from one refusal to the next: each decimal number is folded to `#`, so that refusals of
+        // one cause count together, and the first 200 characters of what is left name it (a refused way out's
+        // GoTo and the machine's answer to it).
+        let key: String = fold_decimals(message.trim()).chars().take(200).collect();
         *self.refusals.entry(key).or_default() += 1;
     }
 
@@ -163,5 +165,43 @@ impl Tally {
 
     fn count(&self, counts: &BTreeMap<Kind, usize>, kind: Kind) -> usize {
         counts.get(&kind).copied().unwrap_or(0)
+    }
+}
+
+/// `text` with each decimal number (a run of digits, signs and points holding a point) written `#`; codes and
+/// names such as `0006` and `cmm1` stay.
+fn fold_decimals(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut number = String::new();
+    let flush = |number: &mut String, out: &mut String| {
+        if number.contains('.') && number.chars().any(|c| c.is_ascii_digit()) {
+            out.push('#');
+        } else {
+            out.push_str(number);
+        }
+        number.clear();
+    };
+    for c in text.chars() {
+        if c.is_ascii_digit() || c == '.' || c == '-' {
+            number.push(c);
+        } else {
+            flush(&mut number, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut number, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fold_decimals;
+
+    #[test]
+    fn refusals_differing_only_in_positions_read_the_same() {
+        assert_eq!(
+            fold_decimals("not cleared: machine cmm1: GoTo(X(-10.62), Y(5.0), Z(75)): error 0006 (severity 2)."),
+            "not cleared: machine cmm1: GoTo(X(#), Y(#), Z(75)): error 0006 (severity 2)."
+        );
     }
 }
