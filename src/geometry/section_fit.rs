@@ -128,42 +128,39 @@ const SETTLED_MM: f64 = 1e-6;
 const ZONE_GAIN_MM: f64 = 1e-11;
 
 /// The fit's unknowns: how the section is displaced from the nominal along the chord and the thickness direction
-/// (mm) and turned about the pivot (rad, counter-clockwise), the quantities reported and limited. A measured point
-/// p is brought onto the nominal by the inverse motion: q = R(-turn) (p - pivot - displacement) + pivot.
+/// (mm) and turned about the pivot (rad, counter-clockwise), the quantities reported and limited.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Placement {
     /// (dchord, dn, turn).
     x: Vector3<f64>,
 }
 
-impl Placement {
-    fn displacement(&self, along: &Vector2<f64>, across: &Vector2<f64>) -> Vector2<f64> {
-        along * self.x[0] + across * self.x[1]
+/// The section's own axes: the pivot its turn is about, the chord's unit direction and the thickness direction
+/// (the chord turned +90 degrees). A measured point p is brought onto the nominal by the inverse of a placement:
+/// q = R(-turn) (p - pivot - displacement) + pivot.
+struct SectionAxes {
+    pivot: Vector2<f64>,
+    along: Vector2<f64>,
+    across: Vector2<f64>,
+}
+
+impl SectionAxes {
+    fn displacement(&self, placement: &Placement) -> Vector2<f64> {
+        self.along * placement.x[0] + self.across * placement.x[1]
     }
 
-    fn apply(
-        &self,
-        pivot: &Vector2<f64>,
-        along: &Vector2<f64>,
-        across: &Vector2<f64>,
-        p: &Vector2<f64>,
-    ) -> Vector2<f64> {
-        Rotation2::new(-self.x[2]) * (p - pivot - self.displacement(along, across)) + pivot
+    fn apply(&self, placement: &Placement, p: &Vector2<f64>) -> Vector2<f64> {
+        Rotation2::new(-placement.x[2]) * (p - self.pivot - self.displacement(placement))
+            + self.pivot
     }
 
     /// How q moves with each unknown: d q / d (dchord, dn, turn).
-    fn derivatives(
-        &self,
-        pivot: &Vector2<f64>,
-        along: &Vector2<f64>,
-        across: &Vector2<f64>,
-        p: &Vector2<f64>,
-    ) -> [Vector2<f64>; 3] {
-        let back = Rotation2::new(-self.x[2]);
-        let arm = back * (p - pivot - self.displacement(along, across));
+    fn derivatives(&self, placement: &Placement, p: &Vector2<f64>) -> [Vector2<f64>; 3] {
+        let back = Rotation2::new(-placement.x[2]);
+        let arm = back * (p - self.pivot - self.displacement(placement));
         [
-            -(back * along),
-            -(back * across),
+            -(back * self.along),
+            -(back * self.across),
             Vector2::new(arm.y, -arm.x),
         ]
     }
@@ -193,15 +190,16 @@ pub(crate) fn fit_section(
         });
     }
     let along = chord.try_normalize(0.0).unwrap_or_else(Vector2::x);
-    let across = Vector2::new(-along.y, along.x);
+    let axes = SectionAxes {
+        pivot,
+        along,
+        across: Vector2::new(-along.y, along.x),
+    };
     // A parameter the mode does not move is held at zero, like one limited to zero.
     let bound = limits.bounds();
     let bound = Vector3::from_fn(|k, _| if k < unknowns { bound[k] } else { 0.0 });
     let measure_all = |placement: &Placement| -> Result<Vec<Measured>, SectionFitError> {
-        let moved: Vec<Vector2<f64>> = points
-            .iter()
-            .map(|p| placement.apply(&pivot, &along, &across, p))
-            .collect();
+        let moved: Vec<Vector2<f64>> = points.iter().map(|p| axes.apply(placement, p)).collect();
         measure(&moved)
             .into_iter()
             .enumerate()
@@ -241,7 +239,7 @@ pub(crate) fn fit_section(
                 .iter()
                 .zip(&measured)
                 .map(|(p, m)| {
-                    let [a, b, turn] = placement.derivatives(&pivot, &along, &across, p);
+                    let [a, b, turn] = axes.derivatives(&placement, p);
                     let row = Vector3::new(m.normal.dot(&a), m.normal.dot(&b), m.normal.dot(&turn));
                     (m.distance_mm, row)
                 })

@@ -203,6 +203,21 @@ fn the_minimum_zone_is_never_wider_than_the_least_squares_band() {
     }
 }
 
+/// Two fits of one section placed alike and leaving the same zone, within what a settled step may still move (a
+/// nanometre; the twist in degrees).
+fn assert_same_fit(a: &SectionFit, b: &SectionFit, what: &str) {
+    let pairs = [
+        (a.dn_mm, b.dn_mm),
+        (a.dchord_mm, b.dchord_mm),
+        (a.rotation_deg, b.rotation_deg),
+        (a.form.zone_mm, b.form.zone_mm),
+    ];
+    assert!(
+        pairs.iter().all(|(x, y)| (x - y).abs() < 1e-6),
+        "{what}: (dn, dchord, twist, zone) {pairs:?}"
+    );
+}
+
 #[test]
 fn a_fit_held_within_a_limit_stops_at_it_and_leaves_the_rest_in_the_form() {
     let nominal = Polygon::blade();
@@ -237,14 +252,13 @@ fn a_fit_held_within_a_limit_stops_at_it_and_leaves_the_rest_in_the_form() {
         };
         let pinned = fit_within(&nominal, &moved_back, FitMode::Full, method, &fixed);
         assert_eq!(pinned.dn_mm, 0.0);
-        assert!(
-            // Both settle once a step moves no point by a nanometre.
-            (pinned.dchord_mm - held.dchord_mm).abs() < 1e-6
-                && (pinned.rotation_deg - held.rotation_deg).abs() < 1e-6
-                && (pinned.form.zone_mm - held.form.zone_mm).abs() < 1e-6,
-            "{method:?}: held {:?} / pinned {:?}",
-            (held.dchord_mm, held.rotation_deg, held.form),
-            (pinned.dchord_mm, pinned.rotation_deg, pinned.form)
+        assert_same_fit(
+            &SectionFit {
+                dn_mm: 0.25,
+                ..pinned
+            },
+            &held,
+            &format!("{method:?}, held and pinned"),
         );
         // Limits the motion does not reach change nothing.
         let loose = FitLimits {
@@ -255,12 +269,7 @@ fn a_fit_held_within_a_limit_stops_at_it_and_leaves_the_rest_in_the_form() {
         let free = fit(&nominal, &measured, FitMode::Full, method);
         let within = fit_within(&nominal, &measured, FitMode::Full, method, &loose);
         assert_eq!(within.at_limit, [false; 3]);
-        assert!(
-            (within.dn_mm - free.dn_mm).abs() < 1e-6
-                && (within.dchord_mm - free.dchord_mm).abs() < 1e-6
-                && (within.rotation_deg - free.rotation_deg).abs() < 1e-6,
-            "{method:?}"
-        );
+        assert_same_fit(&within, &free, &format!("{method:?}, loose limits"));
         assert!((free.dn_mm - 0.4).abs() < 1e-6 && (free.rotation_deg - angle).abs() < 1e-6);
     }
 }
@@ -279,14 +288,7 @@ fn a_twist_limited_to_zero_is_the_translation_fit() {
         assert_eq!(limited.rotation_deg, 0.0);
         // A limit of zero pins the twist by choice: it is not reported as reached.
         assert_eq!(limited.at_limit, [false; 3]);
-        assert!(
-            (limited.dn_mm - translated.dn_mm).abs() < 1e-6
-                && (limited.dchord_mm - translated.dchord_mm).abs() < 1e-6
-                && (limited.form.zone_mm - translated.form.zone_mm).abs() < 1e-6,
-            "{method:?}: {:?} / {:?}",
-            (limited.dn_mm, limited.dchord_mm, limited.form),
-            (translated.dn_mm, translated.dchord_mm, translated.form)
-        );
+        assert_same_fit(&limited, &translated, &format!("{method:?}, no turn"));
     }
 }
 
