@@ -4,7 +4,7 @@
 
 use zeroset::api::Event;
 
-use crate::daemon::job_over;
+use crate::daemon::{job_over, Station, Watcher};
 use crate::lockout::station;
 use crate::station::{assert_no_repeated_points, point_counts};
 
@@ -159,18 +159,27 @@ fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_oth
     assert_no_repeated_points(&report);
 }
 
+/// Starts an inspection of `serial` watched, and injects `fault` into cmm1 once point `at` of a scan is seen.
+fn inspect_with_fault(station: &mut Station, serial: &str, at: usize, fault: &str) -> Watcher {
+    let mut watcher = station.watch();
+    station.cli_ok(&["inspect", "propeller", "--serial", serial, "--detach"]);
+    watcher.until(
+        60,
+        |e| matches!(e, Event::Point { index, .. } if *index == at),
+    );
+    assert_eq!(
+        station.sim.control(&format!("fault cmm1 {fault}")),
+        format!("ok fault cmm1 {fault}")
+    );
+    watcher
+}
+
 #[test]
 fn a_lost_line_then_clear_reconnects_and_the_job_continues_whole() {
     let mut station = station();
     station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
     let (_, whole) = station.report("SN-WHOLE");
-    let mut watcher = station.watch();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-LINK", "--detach"]);
-    watcher.until(60, |e| matches!(e, Event::Point { index: 50, .. }));
-    assert_eq!(
-        station.sim.control("fault cmm1 disconnect 1000"),
-        "ok fault cmm1 disconnect 1000"
-    );
+    let mut watcher = inspect_with_fault(&mut station, "SN-LINK", 50, "disconnect 1000");
     let stopped = watcher.until(30, |e| matches!(e, Event::JobStopped { .. }));
     let Event::JobStopped { reason, .. } = stopped else {
         unreachable!()
@@ -191,14 +200,8 @@ fn a_scan_that_loses_its_touch_partway_stops_and_after_the_clear_is_scanned_agai
     let mut station = station();
     station.inspected(&["inspect", "propeller", "--serial", "SN-WHOLE"]);
     let (_, whole) = station.report("SN-WHOLE");
-    let mut watcher = station.watch();
-    station.cli_ok(&["inspect", "propeller", "--serial", "SN-TOUCH", "--detach"]);
     // Armed during one scan, the fault takes the next: that scan sends its first half, then 1003.
-    watcher.until(60, |e| matches!(e, Event::Point { index: 20, .. }));
-    assert_eq!(
-        station.sim.control("fault cmm1 no-touch"),
-        "ok fault cmm1 no-touch"
-    );
+    let mut watcher = inspect_with_fault(&mut station, "SN-TOUCH", 20, "no-touch");
     let stopped = watcher.until(60, |e| matches!(e, Event::JobStopped { .. }));
     let Event::JobStopped {
         machine,
