@@ -8,7 +8,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use zeroset::api::Event;
 
-use crate::daemon::{job_over, Station};
+use crate::daemon::{job_over, Station, A_JOB_S};
 
 /// Commands that move the probe or lift a lockout.
 const MOTION_OR_CLEAR: [&str; 7] = [
@@ -138,7 +138,7 @@ fn after_a_fault_abort_moves_nothing_and_only_clear_lifts_the_lockout() {
     // The station works again: a whole inspection to its report.
     let mut watcher = station.watch();
     station.cli_ok(&["inspect", "propeller", "--serial", "SN-L5", "--detach"]);
-    let end = watcher.until(120, job_over);
+    let end = watcher.until(A_JOB_S, job_over);
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     station.kill_daemon();
 }

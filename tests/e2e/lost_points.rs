@@ -4,7 +4,7 @@
 
 use zeroset::api::Event;
 
-use crate::daemon::{job_over, Station, Watcher};
+use crate::daemon::{job_over, Station, Watcher, A_JOB_S};
 use crate::lockout::station;
 use crate::station::{assert_no_repeated_points, point_counts};
 
@@ -92,7 +92,7 @@ fn a_report_that_cannot_be_written_waits_for_the_fix_and_is_written_from_the_sca
     std::fs::remove_file(&blocked).unwrap();
     let seen = watcher.events().len();
     station.cli_ok(&["clear"]);
-    let end = watcher.until(120, job_over);
+    let end = watcher.until(A_JOB_S, job_over);
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     let rescanned = watcher.events()[seen..]
         .iter()
@@ -134,7 +134,7 @@ fn a_complete_scan_file_cut_short_on_disk_is_scanned_again_at_restart_and_no_oth
     station.start_daemon();
     let mut watcher = station.watch();
     station.cli_ok(&["clear"]);
-    let end = watcher.until(120, job_over);
+    let end = watcher.until(A_JOB_S, job_over);
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     let scanned: Vec<_> = watcher
         .events()
@@ -188,7 +188,7 @@ fn a_lost_line_then_clear_reconnects_and_the_job_continues_whole() {
     std::thread::sleep(std::time::Duration::from_millis(1200));
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("continues"), "{cleared}");
-    let end = watcher.until(120, job_over);
+    let end = watcher.until(A_JOB_S, job_over);
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     let (_, report) = station.report("SN-LINK");
     assert_eq!(point_counts(&report), point_counts(&whole));
@@ -219,7 +219,7 @@ fn a_scan_that_loses_its_touch_partway_stops_and_after_the_clear_is_scanned_agai
     assert!(next_step.contains("zeroset clear"), "{next_step}");
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("continues"), "{cleared}");
-    let end = watcher.until(120, job_over);
+    let end = watcher.until(A_JOB_S, job_over);
     assert!(matches!(end, Event::JobFinished { .. }), "{end:?}");
     let (_, report) = station.report("SN-TOUCH");
     assert_eq!(point_counts(&report), point_counts(&whole));

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use zeroset::api::Event;
 
-use crate::daemon::{job_over, Station};
+use crate::daemon::{job_over, Station, A_JOB_S};
 use crate::support::{propeller_part_edited, repo, zeroset};
 
 /// A command running in the background: its output lines as they come, its exit code at the end.
@@ -254,7 +254,7 @@ fn an_abort_and_a_stop_on_a_fault_end_inspect_with_their_codes() {
     // The job was stopped, not ended: cleared, it runs to its end.
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("continues"), "{cleared}");
-    let over = watcher.until(60, job_over);
+    let over = watcher.until(A_JOB_S, job_over);
     assert!(matches!(over, Event::JobFinished { .. }), "{over:?}");
 }
 

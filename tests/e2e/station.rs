@@ -14,7 +14,7 @@ use zeroset_sim::part::curve::SampledCurve;
 use zeroset_sim::part::propeller::PropellerSpec;
 
 use crate::blade_errors::{assert_parameters_read_the_injected_errors, injected};
-use crate::daemon::{job_over, Station};
+use crate::daemon::{job_over, Station, A_JOB_S};
 use crate::sim::{propeller, propeller_spec};
 use crate::support::propeller_part_edited;
 
@@ -676,7 +676,7 @@ fn two_machines_scan_profiles_at_the_same_time() {
     let station = Station::start("two-machines.toml").with_taught_reference();
     let mut watcher = station.watch();
     station.inspected(&["inspect", "propeller", "--serial", "SN-2"]);
-    watcher.until(30, |e| matches!(e, Event::JobFinished { .. }));
+    watcher.until(A_JOB_S, |e| matches!(e, Event::JobFinished { .. }));
     // Each machine's scans as (start, end) times, from the events.
     let mut started: BTreeMap<(String, String, String), u64> = BTreeMap::new();
     let mut spans: Vec<(String, u64, u64)> = Vec::new();
@@ -773,7 +773,7 @@ fn an_emergency_stop_waits_for_clear_then_resumes_without_losing_or_repeating_a_
     );
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("continues"), "{cleared}");
-    watcher.until(30, job_over);
+    watcher.until(A_JOB_S, job_over);
     let (dir, report) = station.report("SN-3");
     assert_eq!(
         point_counts(&report),
@@ -825,7 +825,7 @@ fn a_killed_daemon_resumes_the_job_from_its_last_complete_profile() {
     let mut watcher = station.watch();
     let cleared = station.cli_ok(&["clear"]);
     assert!(cleared.contains("continues"), "{cleared}");
-    watcher.until(60, job_over);
+    watcher.until(A_JOB_S, job_over);
     let rescanned: Vec<_> = watcher
         .events()
         .into_iter()
@@ -891,8 +891,8 @@ fn two_watchers_receive_the_same_events() {
     let mut first = station.watch();
     let mut second = station.watch();
     teach(&station);
-    first.until(30, job_over);
-    second.until(30, job_over);
+    first.until(A_JOB_S, job_over);
+    second.until(A_JOB_S, job_over);
     assert!(first.seen.len() > 100, "{} events", first.seen.len());
     assert_eq!(first.seen, second.seen);
 }
