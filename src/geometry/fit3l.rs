@@ -16,6 +16,7 @@
 //! model. The candidates of one fit share what does not depend on the offset: the point index, the reduced data
 //! rows, the ridge weights and the side probes.
 
+mod ball_index;
 mod design;
 mod lsq;
 mod offsets;
@@ -24,12 +25,12 @@ use nalgebra::{DVector, SVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use self::ball_index::BallIndex;
 use self::design::Monomials;
 use self::lsq::Reduced;
 use self::offsets::{choose_offsets, Offsets};
 use super::distance::{crosses_zero_set, lagrange_newton, ExactDistance, Foot};
 use super::implicit::{Frame, IpModel};
-use super::nearest::PointIndex;
 use super::poly::{factorial, Basis, Poly, MAX_DEGREE};
 use super::sampling::{project_to_zero_set, Aabb, ZeroSetSamples};
 use super::small;
@@ -216,7 +217,7 @@ pub fn fit_ip<const N: usize>(
         (None, FitMethod::Orthogonal) => ORTHOGONAL_START_OFFSETS.to_vec(),
         (None, FitMethod::ThreeL | FitMethod::Ridge) => OFFSET_CANDIDATES.to_vec(),
     };
-    let index = PointIndex::new(&unit);
+    let index = BallIndex::new(&unit);
     let mut offset_sets = OffsetSets::default();
     let probes = SideProbes::new(
         &unit,
@@ -336,7 +337,7 @@ struct OffsetSets {
 impl OffsetSets {
     fn get<const N: usize>(
         &mut self,
-        index: &PointIndex<N>,
+        index: &BallIndex<N>,
         unit: &[SVector<f64, N>],
         normals: &[SVector<f64, N>],
         largest: f64,

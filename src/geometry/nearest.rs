@@ -37,18 +37,6 @@ impl<const N: usize> PointIndex<N> {
         self.tree.nearest_neighbor(array(p)).map(|e| e.data)
     }
 
-    /// Whether some point other than `except` lies strictly within `radius` of `p`. Stops at the first one found
-    /// and visits only the part of the tree near the ball: much cheaper than a nearest-point search where many
-    /// points lie at about the same distance (beside a dense scan).
-    pub fn any_within(&self, p: &SVector<f64, N>, radius: f64, except: usize) -> bool {
-        self.tree
-            .locate_within_distance(array(p), radius * radius)
-            .any(|e| {
-                e.data != except
-                    && (SVector::<f64, N>::from_column_slice(e.geom()) - p).norm() < radius
-            })
-    }
-
     /// Indices of the points by increasing distance from `p`.
     pub fn nearest_iter(&self, p: &SVector<f64, N>) -> impl Iterator<Item = usize> + '_ {
         self.tree.nearest_neighbor_iter(array(p)).map(|e| e.data)

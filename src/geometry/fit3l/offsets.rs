@@ -5,12 +5,12 @@
 //! The test is an emptiness query on a ball (is any other point strictly within 0.98 c?), which stops at the
 //! first point found and only visits the index near the ball, instead of a nearest-neighbour search: beside a dense
 //! scan the offset point's nearest points are all about c away, and a nearest search keeps thousands of them in its
-//! queue. One index serves every candidate of a fit; points are done in parallel.
+//! queue. One index ([`BallIndex`]) serves every candidate of a fit; points are done in parallel.
 
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-use crate::geometry::nearest::PointIndex;
+use super::ball_index::BallIndex;
 
 /// An offset point must be at least this fraction of its offset away from every other data point.
 const OFFSET_CLEARANCE: f64 = 0.98;
@@ -25,7 +25,7 @@ pub(super) struct Offsets {
 
 /// The offsets of every point, starting from `largest`. `index` indexes `unit`.
 pub(super) fn choose_offsets<const N: usize>(
-    index: &PointIndex<N>,
+    index: &BallIndex<N>,
     unit: &[SVector<f64, N>],
     normals: &[SVector<f64, N>],
     largest: f64,
@@ -58,7 +58,7 @@ mod tests {
 
     /// The old path: the nearest data point of the offset point must be the point itself or 0.98 c away.
     fn by_nearest(unit: &[Vector2<f64>], normals: &[Vector2<f64>], largest: f64) -> Vec<Offsets> {
-        let index = PointIndex::new(unit);
+        let index = crate::geometry::nearest::PointIndex::new(unit);
         let safe = |i: usize, direction: f64| -> Option<f64> {
             let mut c = largest;
             for _ in 0..OFFSET_HALVINGS {
@@ -95,7 +95,7 @@ mod tests {
         unit.extend_from_within(0..10);
         normals.extend_from_within(0..10);
         for largest in [0.003, 0.01, 0.03, 0.1] {
-            let index = PointIndex::new(&unit);
+            let index = BallIndex::new(&unit);
             let fast = choose_offsets(&index, &unit, &normals, largest);
             assert_eq!(
                 fast,
