@@ -3,6 +3,7 @@
 //! set from those cells (seeds for the exact distance, so that Newton starts on the near side of a thin section).
 
 use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
 
 use super::implicit::Implicit;
 use super::nearest::PointIndex;
@@ -127,12 +128,29 @@ impl<const N: usize> ZeroSetSamples<N> {
         if grid_samples.is_empty() || data.is_empty() {
             return 0;
         }
+        // A lone component is the one the data lie nearest to: no branch beside them.
+        if self.components <= 1 {
+            return 0;
+        }
         let samples = PointIndex::new(grid_samples);
-        let mut carries = vec![false; self.components];
-        for p in data {
-            if let Some(i) = samples.nearest(p) {
-                carries[self.component_of[i]] = true;
-            }
+        // The components some point lies nearest to, the points in parallel.
+        let carries = data
+            .par_iter()
+            .fold(
+                || vec![false; self.components],
+                |mut carries, p| {
+                    if let Some(i) = samples.nearest(p) {
+                        carries[self.component_of[i]] = true;
+                    }
+                    carries
+                },
+            )
+            .reduce(
+                || vec![false; self.components],
+                |a, b| a.iter().zip(&b).map(|(a, b)| *a || *b).collect(),
+            );
+        if carries.iter().all(|&c| c) {
+            return 0;
         }
         let data_index = PointIndex::new(data);
         let mut closest = vec![f64::INFINITY; self.components];
@@ -395,7 +413,7 @@ mod tests {
     use nalgebra::Vector2;
 
     #[test]
-    fn two_circles_are_two_components_and_samples_lie_on_them() {
+    fn two_circles_are_two_components_samples_lie_on_them_and_a_branch_beside_the_data_counts() {
         // (x^2 + y^2 - 1) * ((x - 3)^2 + y^2 - 1) has two unit circles centred at 0 and 3.
         // Expanded: product of (x^2 + y^2 - 1) and (x^2 - 6x + 8 + y^2).
         let a = Poly::<2>::new(2, vec![-1.0, 0.0, 0.0, 1.0, 0.0, 1.0]);
@@ -437,5 +455,21 @@ mod tests {
             .next()
             .unwrap();
         assert!((near - Vector2::new(3.0, 1.0)).norm() < 0.06);
+        // Data on the first circle: the second, 1 away at its nearest, is a branch beside them within 1.5 and
+        // not within 0.5; data on both circles leave no branch beside them; one circle alone has none.
+        let on = |centre: f64| {
+            (0..500).map(move |k| {
+                let t = k as f64 / 500.0 * std::f64::consts::TAU;
+                Vector2::new(centre + t.cos(), t.sin())
+            })
+        };
+        let first: Vec<Vector2<f64>> = on(0.0).collect();
+        assert_eq!(samples.branches_beside(&first, 1.5), 1);
+        assert_eq!(samples.branches_beside(&first, 0.5), 0);
+        let both: Vec<Vector2<f64>> = on(0.0).chain(on(3.0)).collect();
+        assert_eq!(samples.branches_beside(&both, 1.5), 0);
+        let one = ZeroSetSamples::new(&f.0, &bounds, 140);
+        assert_eq!(one.components(), 1);
+        assert_eq!(one.branches_beside(&first, 10.0), 0);
     }
 }

@@ -60,7 +60,9 @@ impl<const N: usize> BallIndex<N> {
             let node = &self.nodes[stack[depth]];
             let gap: f64 = (0..N)
                 .map(|k| {
-                    let d = (node.min[k] - centre[k]).max(centre[k] - node.max[k]).max(0.0);
+                    let d = (node.min[k] - centre[k])
+                        .max(centre[k] - node.max[k])
+                        .max(0.0);
                     d * d
                 })
                 .sum();
@@ -161,7 +163,8 @@ mod tests {
         let index = BallIndex::new(&curve);
         for _ in 0..4_000 {
             let except = rng.gen_range(0..curve.len());
-            let centre = curve[except] + Vector2::new(rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1));
+            let centre =
+                curve[except] + Vector2::new(rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1));
             let radius = rng.gen_range(1e-6..0.2);
             let expected = by_every_point(&curve, &centre, radius, except);
             assert_eq!(index.any_within(&centre, radius, except), expected);
