@@ -5,7 +5,8 @@
 //! so an empty ball must still visit the index's leaves along a few hundred points of the curve, and rstar's
 //! general selection iterator (a work list of boxed nodes per query) spent three times as long walking its tree as
 //! on the points (perf, BENCHMARKS.md). This is a static k-d tree of contiguous leaves walked with a fixed stack:
-//! the same points visited, far less per visit. Split by count at the median of the widest side, so that many equal
+//! it visits other boxes than the R-tree did, but makes the same comparison on each point it reaches and gives the
+//! same answer, at far less per visit. Split by count at the median of the widest side, so that many equal
 //! coordinates (a stack's planes) cannot overflow a bucket.
 
 use nalgebra::SVector;
@@ -160,19 +161,19 @@ mod tests {
             })
             .collect();
         let mut checked = (0, 0);
-        let index = BallIndex::new(&curve);
+        let curve_index = BallIndex::new(&curve);
         for _ in 0..4_000 {
             let except = rng.gen_range(0..curve.len());
             let centre =
                 curve[except] + Vector2::new(rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1));
             let radius = rng.gen_range(1e-6..0.2);
             let expected = by_every_point(&curve, &centre, radius, except);
-            assert_eq!(index.any_within(&centre, radius, except), expected);
+            assert_eq!(curve_index.any_within(&centre, radius, except), expected);
             checked.0 += usize::from(expected);
             // A ball through a point exactly: strictly within excludes it.
             let through = (curve[(except + 1) % curve.len()] - centre).norm();
             assert_eq!(
-                index.any_within(&centre, through, except),
+                curve_index.any_within(&centre, through, except),
                 by_every_point(&curve, &centre, through, except)
             );
         }
@@ -189,5 +190,13 @@ mod tests {
         assert!(checked.0 > 400 && checked.0 < 3_600, "{checked:?}");
         assert!(checked.1 > 200 && checked.1 < 1_800, "{checked:?}");
         assert!(!BallIndex::<2>::new(&[]).any_within(&Vector2::zeros(), 1.0, 0));
+        // The point left out is the one given, by its index in the input: a tiny ball on a point holds only it,
+        // and a copy of it at another index counts.
+        let lone = 1_234;
+        assert!(!curve_index.any_within(&curve[lone], 1e-9, lone));
+        assert!(curve_index.any_within(&curve[lone], 1e-9, lone + 1));
+        let mut doubled = curve.clone();
+        doubled.push(curve[lone]);
+        assert!(BallIndex::new(&doubled).any_within(&curve[lone], 1e-9, lone));
     }
 }

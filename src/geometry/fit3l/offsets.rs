@@ -54,11 +54,12 @@ pub(super) fn choose_offsets<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::nearest::PointIndex;
     use nalgebra::Vector2;
 
     /// The old path: the nearest data point of the offset point must be the point itself or 0.98 c away.
     fn by_nearest(unit: &[Vector2<f64>], normals: &[Vector2<f64>], largest: f64) -> Vec<Offsets> {
-        let index = crate::geometry::nearest::PointIndex::new(unit);
+        let index = PointIndex::new(unit);
         let safe = |i: usize, direction: f64| -> Option<f64> {
             let mut c = largest;
             for _ in 0..OFFSET_HALVINGS {
