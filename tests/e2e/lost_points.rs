@@ -15,16 +15,7 @@ fn a_scan_that_lost_a_line_of_points_is_scanned_again_to_its_full_count() {
     let (_, whole) = station.report("SN-WHOLE");
     // Lines lost early, midway and late in a profile's scan, in different profiles.
     for (serial, at) in [("SN-D1", 25), ("SN-D2", 120), ("SN-D3", 300)] {
-        let mut watcher = station.watch();
-        station.cli_ok(&["inspect", "propeller", "--serial", serial, "--detach"]);
-        watcher.until(
-            60,
-            |e| matches!(e, Event::Point { index, .. } if *index == at),
-        );
-        assert_eq!(
-            station.sim.control("fault cmm1 drop-lines 1"),
-            "ok fault cmm1 drop-lines 1"
-        );
+        let mut watcher = inspect_with_fault(&mut station, serial, at, "drop-lines 1");
         let mut rescans = 0;
         let end = loop {
             let event = watcher.until(120, |e| {
