@@ -51,21 +51,30 @@
 //! exact where the surface is straight along that direction) moves it to `c - r / cos(tilt) N_plane`: the section
 //! point is where a circle of radius `rho = r / cos(tilt)` about the centre touches the section curve.
 //!
+//! The roll: where the ball rolls round an edge (sharp, or round with a radius up to a quarter of the ball's), its
+//! centres lie on one circle, and the contact comes from that circle, fitted to the roll's centres up to the
+//! look-ahead, instead of the quartic (see `roll` for why the quartic fails there).
+//!
 //! Streaming: a point is compensated once the K = 4 points after it have arrived. The first and last K points of an
 //! open path have no symmetric window and use the reported normal, as do points where the fit cannot work. Until
 //! then a point has a provisional compensation, from the window that ends at it ([`Compensator::preview`]): a
 //! machine sends its points in lines of several, so the last K of a line would otherwise wait a whole line for
 //! their look-ahead, and the live deviation with them.
 
-use std::collections::VecDeque;
+mod roll;
 
-use nalgebra::{Point3, SMatrix, SVector, Unit, Vector3};
+use nalgebra::{Point3, SMatrix, SVector, Unit, Vector2, Vector3};
+
+use roll::{roll_through, RollSample, REACH_BACK};
 
 /// Points on each side of the one being compensated: the look-ahead, in points.
 pub const LOOK_AHEAD: usize = 4;
 
 /// Points in a fitting window.
 const WINDOW: usize = 2 * LOOK_AHEAD + 1;
+
+/// Samples kept: a window, and the centres before it that a roll round an edge may reach back to.
+const HISTORY: usize = WINDOW + REACH_BACK;
 
 /// Coefficients of the quartic.
 const TERMS: usize = 5;
@@ -144,6 +153,9 @@ pub enum Method {
     /// From the centre path's local fit; the section's curvature there (1/mm, signed as in the module comment:
     /// concave positive).
     PathFit { surface_curvature: f64 },
+    /// From the circle of the centres of a roll round an edge (see `roll`); the edge's radius, mm (about 0 at a
+    /// sharp edge, within the noise either way).
+    Roll { edge_radius_mm: f64 },
     /// Along the machine's reported normal, slid into the plane.
     Reported(Fallback),
     /// Along the machine's reported normal, and flagged: the point is kept but its contact is not trusted.
@@ -183,8 +195,8 @@ struct Sample {
 pub struct Compensator {
     settings: CompensationSettings,
     plane_normal: Unit<Vector3<f64>>,
-    /// The last up to `WINDOW` samples.
-    recent: VecDeque<Sample>,
+    /// The last up to `HISTORY` samples, oldest first.
+    recent: Vec<Sample>,
     /// Samples received so far.
     received: usize,
 }
@@ -195,7 +207,7 @@ impl Compensator {
         Compensator {
             settings,
             plane_normal: Unit::new_normalize(plane_normal),
-            recent: VecDeque::with_capacity(WINDOW),
+            recent: Vec::with_capacity(HISTORY),
             received: 0,
         }
     }
@@ -208,10 +220,10 @@ impl Compensator {
         reported_normal: Vector3<f64>,
     ) -> Option<Compensated> {
         let sample = self.sample(centre, reported_normal);
-        if self.recent.len() == WINDOW {
-            self.recent.pop_front();
+        if self.recent.len() == HISTORY {
+            self.recent.remove(0);
         }
-        self.recent.push_back(sample);
+        self.recent.push(sample);
         self.received += 1;
         let index = self.received - 1;
         if index < LOOK_AHEAD {
@@ -221,7 +233,11 @@ impl Compensator {
         if self.recent.len() < WINDOW {
             return None;
         }
-        Some(self.fitted(index - LOOK_AHEAD, &self.window(), LOOK_AHEAD))
+        Some(self.fitted(
+            index - LOOK_AHEAD,
+            &self.recent,
+            self.recent.len() - 1 - LOOK_AHEAD,
+        ))
     }
 
     /// The newest point's provisional compensation, while its final one waits for the look-ahead: from the
@@ -239,15 +255,10 @@ impl Compensator {
             return None;
         }
         if self.recent.len() < WINDOW {
-            let sample = self.recent.back()?;
+            let sample = self.recent.last()?;
             return Some(self.reported(newest, sample, Method::Reported(Fallback::PathEnd)));
         }
-        Some(self.fitted(newest, &self.window(), WINDOW - 1))
-    }
-
-    /// The last `WINDOW` samples; only called once that many have come.
-    fn window(&self) -> [Sample; WINDOW] {
-        std::array::from_fn(|i| self.recent[i])
+        Some(self.fitted(newest, &self.recent, self.recent.len() - 1))
     }
 
     /// Ends the path: returns the points still waiting for their look-ahead (the path's end, along the reported
@@ -307,9 +318,15 @@ impl Compensator {
         }
     }
 
-    /// The point at `at` of a full window (its middle, or its end for a preview), from the quartic fit of its
-    /// centre path in a frame about that point.
-    fn fitted(&self, index: usize, window: &[Sample; WINDOW], at: usize) -> Compensated {
+    /// The point at `at` of `history` (the samples up to the newest, at least a window of them; the point is the
+    /// last window's middle, or its end for a preview): from the circle of a roll round an edge through it, if
+    /// there is one, else from the quartic fit of the last window's centre path in a frame about the point.
+    fn fitted(&self, index: usize, history: &[Sample], at: usize) -> Compensated {
+        if let Some(rolled) = self.rolled(index, history, at) {
+            return rolled;
+        }
+        let window: [Sample; WINDOW] = std::array::from_fn(|i| history[history.len() - WINDOW + i]);
+        let at = at + WINDOW - history.len();
         let middle = &window[at];
         let unresolved = Method::Reported(Fallback::Unresolved);
         if window.iter().any(|s| !s.rho.is_finite()) {
@@ -394,6 +411,36 @@ impl Compensator {
             },
         }
     }
+
+    /// The point at `at` of `history` compensated from a roll round an edge through it, if its centres make one
+    /// (see `roll`): the centre moved back `rho` towards the roll's middle.
+    fn rolled(&self, index: usize, history: &[Sample], at: usize) -> Option<Compensated> {
+        let w = self.plane_normal.into_inner();
+        let u = w
+            .cross(&Vector3::x())
+            .try_normalize(1e-3)
+            .unwrap_or_else(|| w.cross(&Vector3::y()).normalize());
+        let v = w.cross(&u);
+        let middle = &history[at];
+        let in_plane = |p: Vector3<f64>| Vector2::new(p.dot(&u), p.dot(&v));
+        let samples: Vec<RollSample> = history
+            .iter()
+            .map(|s| RollSample {
+                centre: in_plane(s.centre - middle.centre),
+                rho: s.rho,
+                normal: in_plane(s.normal),
+            })
+            .collect();
+        let (outward, edge_radius_mm) = roll_through(&samples, at, self.settings.noise_sigma_mm)?;
+        let towards_surface = u * outward.x + v * outward.y;
+        let tilt = middle.normal.dot(&w);
+        Some(Compensated {
+            index,
+            surface: middle.centre - towards_surface * middle.rho,
+            normal: towards_surface * (1.0 - tilt * tilt).sqrt() + w * tilt,
+            method: Method::Roll { edge_radius_mm },
+        })
+    }
 }
 
 /// Compensates a whole scan at once: the points in scan order, each with its reported normal. A `closed` path
@@ -420,11 +467,15 @@ pub fn compensate_path(
         .map(|(c, n)| compensator.sample(*c, *n))
         .collect();
     let count = samples.len();
+    // Each point's history wraps round the closed path, as far back as the streaming one reaches but never onto
+    // its own look-ahead.
+    let back = (HISTORY - 1 - LOOK_AHEAD).min(count - 1 - LOOK_AHEAD);
     (0..count)
         .map(|i| {
-            let window: [Sample; WINDOW] =
-                std::array::from_fn(|j| samples[(i + count + j - LOOK_AHEAD) % count]);
-            compensator.fitted(i, &window, LOOK_AHEAD)
+            let history: Vec<Sample> = (0..=back + LOOK_AHEAD)
+                .map(|j| samples[(i + count * 2 + j - back) % count])
+                .collect();
+            compensator.fitted(i, &history, back)
         })
         .collect()
 }

@@ -1,0 +1,283 @@
+//! The ball rolling round an edge: a run of centres on one circle, whose centre is the edge's (or its round's)
+//! middle.
+//!
+//! Why the quartic is not enough there: a scan turns the ball round a sharp or small-radius edge in steps of a few
+//! degrees, so the centre path's curvature jumps from about 0 on a face to 1 / r on the roll within one step, and
+//! the steps themselves shrink from the face's spacing to the roll's. A window of nine centres that straddles the
+//! jump still fits a quartic to the noise (the path is smooth to first order), but its slope is off by tens of
+//! milliradians: on the simulated propeller's sharp trailing edge (1 mm ball, 10 deg steps, 2 um noise) the
+//! contacts whose windows reach from the roll onto the face stood 17 and 27 um proud of the edge, and the chord
+//! ended on them. Along the roll itself a quartic of nine centres spends five coefficients on a circle, and its
+//! slope's noise (0.34 sigma / h) moves each contact along the ball by r times that, off the edge's apex.
+//!
+//! A circle has three parameters and describes the roll exactly, whatever the edge's radius (a sharp edge's centre
+//! path is a circle of the ball's radius about the apex; a round of radius R gives one of radius R + r about its
+//! middle). So where the centres round the point being compensated lie on one circle within the noise, over a run
+//! that may reach back beyond the quartic's window but not ahead of its look-ahead, and that circle is an edge's
+//! (its surface radius at most [`MAX_EDGE_RADIUS`] of the ball's), the contact is taken from it: the centre moved
+//! towards the circle's middle by the ball's radius. A face's centres leave the circle by the square of their
+//! distance from the roll, so only a face's point within a tenth of a millimetre or so of the roll's end can be
+//! taken as the roll's (its contact then moves along the face towards the edge, and off it by no more than the
+//! noise allows).
+
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+
+/// Centres before the point being compensated that a run may reach back to (beyond the quartic's window): a 1 mm
+/// ball turning 10 deg per point takes 16 points round a sharp 20 deg trailing edge.
+pub(super) const REACH_BACK: usize = 24;
+
+/// A run of centres is a roll when their circle's surface radius (its radius less the ball's) is at most this
+/// fraction of the ball's radius: there the quartic cannot follow the path at the steps a scan takes; wider rounds
+/// (an airfoil's nose) are left to it, which follows them exactly.
+const MAX_EDGE_RADIUS: f64 = 0.25;
+
+/// Every centre of a roll lies this many noise sigmas or less from its circle.
+const MAX_SIGMAS: f64 = 4.0;
+
+/// A centre lies on the circle of the run beside it within this many noise sigmas (the circle's own noise added
+/// to the centre's, extrapolated one step). A face's centre within `sqrt(2 x 6 sigma)` of the roll's end along the
+/// face passes, and its contact is taken off the circle: up to 6 sigma proud of the face.
+const PREDICTION_SIGMAS: f64 = 6.0;
+
+/// Residuals are allowed at least this much (mm), as for the quartic: noise-free paths fit to round-off.
+const RESIDUAL_FLOOR_MM: f64 = 1e-4;
+
+/// A roll has at least this many centres ...
+const MIN_POINTS: usize = 5;
+
+/// ... turning through at least this much from its first to its last, rad: 40 deg, five centres at a scan's
+/// usual 10 deg steps. Over less a short arc's circle is no surer than the quartic.
+const MIN_TURN_RAD: f64 = 0.69;
+
+/// A run is taken as a round edge's (its radius fitted) only over at least this many centres; a shorter run's is
+/// a sharp edge's or none. With a free radius a short run's circle takes in a face's centre next to the roll (the
+/// radius swings by a tenth of a millimetre to reach it), and it leans the contacts along the ball by tens of
+/// microns.
+const MIN_ROUND_POINTS: usize = 2 * MIN_POINTS - 1;
+
+/// Gauss-Newton steps of the circle fit, after its algebraic start.
+const FIT_STEPS: usize = 6;
+
+/// One centre of a run, in the section plane (2-D, mm): where it is, the radius `rho` of the ball's circle in the
+/// plane there, and the in-plane direction of its reported normal (only orients the material side).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RollSample {
+    pub centre: Vector2<f64>,
+    pub rho: f64,
+    pub normal: Vector2<f64>,
+}
+
+/// The roll through the point `at` of `samples` (the point's centres before and up to its look-ahead): the
+/// in-plane unit direction from the roll's middle to the point's centre (the contact is the centre moved back
+/// `rho` along it) and the edge's surface radius, mm. `None` where no run of centres through the point is a roll.
+///
+/// The run ends at the latest sample with which the point's centres still lie on one circle, then reaches back
+/// as far as they do.
+pub(super) fn roll_through(
+    samples: &[RollSample],
+    at: usize,
+    noise_sigma_mm: f64,
+) -> Option<(Vector2<f64>, f64)> {
+    let tolerance = (MAX_SIGMAS * noise_sigma_mm).max(RESIDUAL_FLOOR_MM);
+    let ball = samples[at].rho;
+    let edge_circle = |run: &[RollSample]| {
+        if !bends_like_an_edge(run, ball) {
+            return None;
+        }
+        let circle = if run.len() < MIN_ROUND_POINTS {
+            Circle::algebraic(run)?.sharpened(run)?
+        } else {
+            Circle::fit(run).filter(|c| c.is_edge(ball))?
+        };
+        circle.holds(run, tolerance).then_some(circle)
+    };
+    // A centre joins a run only if it lies on the circle of the run without it: a face's centre next to the roll
+    // leaves the circle by the square of its distance from the roll's end, which a refit would take in, leaning
+    // the circle and every contact taken from it.
+    let predicted = |circle: &Circle, centre: &RollSample| {
+        circle.holds(
+            std::slice::from_ref(centre),
+            PREDICTION_SIGMAS / MAX_SIGMAS * tolerance,
+        )
+    };
+    // ... of the same kind as the run's: a sharp edge's, or a round one's fitted with its radius.
+    let on_circle_of = |kind: &Circle, run: &[RollSample], centre: &RollSample| {
+        kind.refit(run).is_some_and(|c| predicted(&c, centre))
+    };
+    // The run from a core of centres `start..=end`, reaching back as far as its centres lie on its circle.
+    let run_from = |mut start: usize, end: usize| {
+        let mut circle = edge_circle(&samples[start..=end])?;
+        if !on_circle_of(&circle, &samples[start..end], &samples[end])
+            || !on_circle_of(&circle, &samples[start + 1..=end], &samples[start])
+        {
+            return None;
+        }
+        while start > 0 && predicted(&circle, &samples[start - 1]) {
+            match edge_circle(&samples[start - 1..=end]) {
+                Some(wider) => circle = wider,
+                None => break,
+            }
+            start -= 1;
+        }
+        let roll = circle.roll_at(&samples[start..=end], at - start)?;
+        Some((end - start, roll))
+    };
+    // The latest end first; from the fewest centres that can show a sharp edge, and from the fewest that can show
+    // a round one, the longer run (a round's first centres fit a sharp edge's circle too, but their run stops
+    // where the round's goes on).
+    (at..samples.len()).rev().find_map(|end| {
+        [MIN_POINTS, MIN_ROUND_POINTS]
+            .into_iter()
+            .filter_map(|points| run_from((end + 1).checked_sub(points)?.min(at), end))
+            .max_by_key(|(length, _)| *length)
+            .map(|(_, roll)| roll)
+    })
+}
+
+/// Whether the circle through a run's first, middle and last centres is anywhere near an edge's for a ball of
+/// in-plane radius `ball` (within twice [`MAX_EDGE_RADIUS`] of the ball's radius): a cheap look that spares a face's
+/// points (their centres on a nearly straight path) the fits.
+fn bends_like_an_edge(run: &[RollSample], ball: f64) -> bool {
+    let (a, b, c) = (
+        run[0].centre,
+        run[run.len() / 2].centre,
+        run[run.len() - 1].centre,
+    );
+    let twice_area = (b - a).perp(&(c - a)).abs();
+    let circumradius = (b - a).norm() * (c - b).norm() * (c - a).norm() / (2.0 * twice_area);
+    (circumradius - ball).abs() <= 2.0 * MAX_EDGE_RADIUS * ball
+}
+
+/// A circle fitted to a run's centres: its middle, and the surface radius `R` with `|c - middle| = rho + R`.
+#[derive(Debug, Clone, Copy)]
+struct Circle {
+    middle: Vector2<f64>,
+    surface_radius: f64,
+}
+
+impl Circle {
+    /// The algebraic circle through the centres (Kasa's: `x^2 + y^2 + D x + E y + F = 0` by least squares), the
+    /// start of the orthogonal fits, its surface radius the mean `rho` taken off. `None` for centres on a line.
+    fn algebraic(run: &[RollSample]) -> Option<Self> {
+        let origin = run[0].centre;
+        let mut normal_matrix = Matrix3::<f64>::zeros();
+        let mut rhs = Vector3::<f64>::zeros();
+        for s in run {
+            let p = s.centre - origin;
+            let row = Vector3::new(p.x, p.y, 1.0);
+            normal_matrix += row * row.transpose();
+            rhs -= row * p.norm_squared();
+        }
+        let abc = normal_matrix.lu().solve(&rhs)?;
+        let middle = Vector2::new(-abc.x / 2.0, -abc.y / 2.0);
+        let radius_sq = middle.norm_squared() - abc.z;
+        if !(radius_sq.is_finite() && radius_sq > 0.0) {
+            return None;
+        }
+        let mean_rho = run.iter().map(|s| s.rho).sum::<f64>() / run.len() as f64;
+        Some(Circle {
+            middle: middle + origin,
+            surface_radius: radius_sq.sqrt() - mean_rho,
+        })
+    }
+
+    /// The least-squares circle (orthogonal distances, each centre's own `rho` taken off), refined from the
+    /// algebraic one by Gauss-Newton. `None` for centres on a line or repeated.
+    fn fit(run: &[RollSample]) -> Option<Self> {
+        let start = Self::algebraic(run)?;
+        let origin = run[0].centre;
+        let mut middle = start.middle - origin;
+        let mut surface_radius = start.surface_radius;
+        for _ in 0..FIT_STEPS {
+            let mut jtj = Matrix3::<f64>::zeros();
+            let mut jtr = Vector3::<f64>::zeros();
+            for s in run {
+                let offset = s.centre - origin - middle;
+                let distance = offset.norm();
+                if distance == 0.0 {
+                    return None;
+                }
+                let residual = distance - s.rho - surface_radius;
+                let unit = offset / distance;
+                let gradient = Vector3::new(-unit.x, -unit.y, -1.0);
+                jtj += gradient * gradient.transpose();
+                jtr += gradient * residual;
+            }
+            let step = jtj.lu().solve(&-jtr)?;
+            middle += Vector2::new(step.x, step.y);
+            surface_radius += step.z;
+        }
+        let middle = middle + origin;
+        (middle.iter().all(|v| v.is_finite()) && surface_radius.is_finite()).then_some(Circle {
+            middle,
+            surface_radius,
+        })
+    }
+
+    /// The circle of a sharp edge (surface radius 0: the centres a ball's radius from the apex) fitted to `run`
+    /// by Gauss-Newton from this one's middle. A short run's free radius is noisy (tens of microns over five
+    /// centres), which moves the contacts along the ball; where the centres cannot tell the edge from a sharp one,
+    /// it is taken as sharp.
+    fn sharpened(&self, run: &[RollSample]) -> Option<Self> {
+        let mut middle = self.middle;
+        for _ in 0..FIT_STEPS {
+            let mut jtj = Matrix2::<f64>::zeros();
+            let mut jtr = Vector2::<f64>::zeros();
+            for s in run {
+                let offset = s.centre - middle;
+                let distance = offset.norm();
+                if distance == 0.0 {
+                    return None;
+                }
+                let gradient = -offset / distance;
+                jtj += gradient * gradient.transpose();
+                jtr += gradient * (distance - s.rho);
+            }
+            middle += jtj.lu().solve(&-jtr)?;
+        }
+        middle.iter().all(|v| v.is_finite()).then_some(Circle {
+            middle,
+            surface_radius: 0.0,
+        })
+    }
+
+    /// The circle of the same kind as this one (sharp, or round with its radius fitted) fitted to `run`.
+    fn refit(&self, run: &[RollSample]) -> Option<Self> {
+        match self.surface_radius {
+            0.0 => Self::algebraic(run)?.sharpened(run),
+            _ => Self::fit(run),
+        }
+    }
+
+    /// Whether every centre of `run` lies within `tolerance` of the circle.
+    fn holds(&self, run: &[RollSample], tolerance: f64) -> bool {
+        run.iter().all(|s| {
+            ((s.centre - self.middle).norm() - s.rho - self.surface_radius).abs() <= tolerance
+        })
+    }
+
+    /// Whether the circle is an edge's for a ball of in-plane radius `ball`: its surface radius within
+    /// [`MAX_EDGE_RADIUS`] of the ball's either side of zero (a short run's radius is noisy; a path tighter than
+    /// that is no surface's offset, and the quartic flags it).
+    fn is_edge(&self, ball: f64) -> bool {
+        self.surface_radius.abs() <= MAX_EDGE_RADIUS * ball
+    }
+
+    /// The roll's answer for the run's sample `at`, if the run is a roll: the circle's middle on the material
+    /// side of every centre (a convex edge, as every reported normal says), the run turning through
+    /// [`MIN_TURN_RAD`].
+    fn roll_at(&self, run: &[RollSample], at: usize) -> Option<(Vector2<f64>, f64)> {
+        let outward = |s: &RollSample| (s.centre - self.middle).normalize();
+        if !run.iter().all(|s| outward(s).dot(&s.normal) > 0.0) {
+            return None;
+        }
+        let turn: f64 = run
+            .windows(2)
+            .map(|pair| {
+                let (from, to) = (outward(&pair[0]), outward(&pair[1]));
+                from.perp(&to).atan2(from.dot(&to))
+            })
+            .sum();
+        (turn.abs() >= MIN_TURN_RAD).then(|| (outward(&run[at]), self.surface_radius))
+    }
+}
