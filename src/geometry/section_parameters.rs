@@ -11,9 +11,13 @@
 //!
 //! Definitions (each measured the same way on the scanned section and on the nominal, so that their differences
 //! are the errors):
-//! - The nose and tail are the two outline points farthest apart; the chord joins them. The leading edge is the
-//!   blunter end: the one whose section is thicker at `EDGE_PROBE` of the chord in from it (an airfoil's round
-//!   nose against its thin tail).
+//! - The nose and tail are the two outline points farthest apart, each moved out along the chord by how far it
+//!   lies behind the tip of its edge's circle where the edge is round (see the edge radius below: a scan's points
+//!   step round a nose, and the farthest of them misses its tip by a few microns), or replaced by the mean of its
+//!   cluster where a ball rolling round a sharp end left one (the farthest of a noisy cluster stands proud of
+//!   it); the chord joins them. The leading edge is the blunter end: the one
+//!   whose section is thicker at `EDGE_PROBE` of the chord in from it (an airfoil's round nose against its thin
+//!   tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
 //!   to the chord meets the outline on both faces; the section's thickness there is the length between them.
 //! - The maximum thickness: the diameter of the largest circle inside the outline, found as the largest of the
@@ -34,10 +38,15 @@
 
 use nalgebra::Vector2;
 
-use super::circle::fit_circle;
+use super::circle::{fit_circle, Circle};
 
 /// Where the ends are told apart: thickness this fraction of the chord in from each end.
 const EDGE_PROBE: f64 = 0.05;
+/// Outline points within this of a sharp end's farthest point are its cluster of contacts (mm): the roll's
+/// contacts scatter by the probe's noise, a few microns; a face's points lie a scan step apart.
+const TIP_CLUSTER_MM: f64 = 0.01;
+/// A sharp end's farthest point is replaced by its cluster's mean when the cluster has this many points.
+const TIP_CLUSTER_POINTS: usize = 3;
 /// Stations along the chord at which the inscribed circles are sampled before the largest is refined.
 const STATIONS: usize = 200;
 /// The golden-section searches stop below this, mm.
@@ -157,6 +166,38 @@ pub(crate) fn section_parameters(
     } else {
         (b, a)
     };
+    // A round end's tip lies beyond its farthest point: the outline's points step round a nose by several
+    // degrees (10 at the simulated scan's nose), so the farthest of them falls short of the tip by r (1 - cos a),
+    // a its angle from the tip about the nose's centre: up to 5 um on a 2.5 mm nose, differently on every scan.
+    // The edge's circle gives that shortfall; the end is moved out along the chord by it, so that a dense outline
+    // (a nominal's) keeps its own tip whatever the circle's fit to the nose's shape. The edge thicknesses are taken
+    // from the moved ends.
+    let inward = (trailing_edge - leading_edge).normalize();
+    let zone_mm = edge_distance_mm / 2.0;
+    let le_circle = edge_circle(outline, leading_edge, inward, zone_mm);
+    let te_circle = edge_circle(outline, trailing_edge, -inward, zone_mm);
+    // A sharp end scanned by a ball rolling round it is a cluster of contacts at one point, each off it by the
+    // probe's noise: the farthest of them stands about two sigmas proud, so the tip is their mean.
+    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| match circle {
+        Some(c) => {
+            let cos_off_tip = (end - c.centre).normalize().dot(&outward);
+            end + outward * (c.radius * (1.0 - cos_off_tip))
+        }
+        None => {
+            let cluster: Vec<&Vector2<f64>> = outline
+                .iter()
+                .filter(|p| (*p - end).norm() <= TIP_CLUSTER_MM)
+                .collect();
+            let count = cluster.len();
+            match count >= TIP_CLUSTER_POINTS {
+                true => cluster.into_iter().sum::<Vector2<f64>>() / count as f64,
+                false => end,
+            }
+        }
+    };
+    let leading_edge = to_tip(leading_edge, le_circle, -inward);
+    let trailing_edge = to_tip(trailing_edge, te_circle, inward);
+    let chord_mm = (trailing_edge - leading_edge).norm();
     let across = Across::new(outline, leading_edge, trailing_edge);
     let le_thickness_mm = across.thickness_at(edge_distance_mm)?;
     let te_thickness_mm = across.thickness_at(chord_mm - edge_distance_mm)?;
@@ -184,9 +225,6 @@ pub(crate) fn section_parameters(
     }
     let largest_radius_mm = across.inscribed_at(station)?;
     let mean_line = MeanLine::of(&across, chord_mm)?;
-    let zone_mm = edge_distance_mm / 2.0;
-    let le_radius_mm = edge_radius(outline, leading_edge, across.along, zone_mm);
-    let te_radius_mm = edge_radius(outline, trailing_edge, -across.along, zone_mm);
     Ok(SectionParameters {
         leading_edge,
         trailing_edge,
@@ -195,19 +233,20 @@ pub(crate) fn section_parameters(
         max_thickness_at: station / chord_mm,
         le_thickness_mm,
         te_thickness_mm,
-        le_radius_mm,
-        te_radius_mm,
+        le_radius_mm: le_circle.map(|c| c.radius),
+        te_radius_mm: te_circle.map(|c| c.radius),
         mean_line,
     })
 }
 
-/// The radius of the edge at `tip` whose section lies towards `inward` (unit): see the module's definition.
-fn edge_radius(
+/// The circle of the edge at `tip` whose section lies towards `inward` (unit), if the edge is round: see the
+/// module's definition of an edge's radius.
+fn edge_circle(
     outline: &[Vector2<f64>],
     tip: Vector2<f64>,
     inward: Vector2<f64>,
     zone_mm: f64,
-) -> Option<f64> {
+) -> Option<Circle> {
     let within = |depth: f64| -> Vec<Vector2<f64>> {
         outline
             .iter()
@@ -238,7 +277,7 @@ fn edge_radius(
             (l.min(a), h.max(a))
         });
     let round = circle.rms_mm <= EDGE_ROUNDNESS * circle.radius;
-    (round && (high - low).to_degrees() >= EDGE_MIN_SPAN_DEG).then_some(circle.radius)
+    (round && (high - low).to_degrees() >= EDGE_MIN_SPAN_DEG).then_some(circle)
 }
 
 impl MeanLine {
