@@ -120,8 +120,11 @@ impl ProfileGauge {
         self.parameters
             .get_or_init(|| match &self.model {
                 GaugeModel::Ip {
-                    model, nominals, ..
-                } => section::nominal_parameters(model, nominals),
+                    model,
+                    nominals,
+                    edges,
+                    ..
+                } => section::nominal_parameters(model, nominals, edges),
                 GaugeModel::Solid(_) => {
                     Err("the reference is a solid, not a stack of sections".into())
                 }

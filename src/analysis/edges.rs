@@ -83,6 +83,45 @@ impl SharpEdge {
     }
 }
 
+/// `outline` (closed, in order round a section) with its tip at each of `edges` made sharp: its points in the
+/// edge's normal cone within [`EDGE_REACH_MM`] of the apex (a polynomial's rounded or overshooting tip) replaced
+/// by the apex itself, between the neighbours it falls between.
+pub(crate) fn sharpen(outline: &[Vector2<f64>], edges: &[SharpEdge]) -> Vec<Vector2<f64>> {
+    let mut outline = outline.to_vec();
+    for edge in edges {
+        let apex = Vector2::from(edge.apex);
+        let beyond = |p: &Vector2<f64>| {
+            let offset = p - apex;
+            offset.norm() <= EDGE_REACH_MM && edge.in_cone(&offset)
+        };
+        let first_beyond = outline.iter().position(beyond);
+        outline.retain(|p| !beyond(p));
+        let n = outline.len();
+        if n < 2 {
+            continue;
+        }
+        let at = first_beyond.unwrap_or_else(|| {
+            // The outline stops short of the apex: it goes in beside its nearest point, on the side it lies.
+            let nearest = (0..n)
+                .min_by(|&i, &j| {
+                    (outline[i] - apex)
+                        .norm()
+                        .total_cmp(&(outline[j] - apex).norm())
+                })
+                .unwrap_or(0);
+            let towards_next =
+                (outline[(nearest + 1) % n] - outline[nearest]).dot(&(apex - outline[nearest]));
+            if towards_next > 0.0 {
+                nearest + 1
+            } else {
+                nearest
+            }
+        });
+        outline.insert(at.min(n), apex);
+    }
+    outline
+}
+
 /// The sharp edges in a scan: runs of one touched point along which the normal turns by more than
 /// [`EDGE_TURN_RAD`]. `points` and `normals` are the profile's compensated points and outward unit normals in the
 /// profile's plane, in scan order. The faces' normals are the normal on arriving at the edge and the normal of the
@@ -164,6 +203,40 @@ mod tests {
             (edge.turn_rad - 160f64.to_radians()).abs() < 1e-9,
             "{edge:?}"
         );
+    }
+
+    #[test]
+    fn an_outline_rounding_or_overshooting_the_tip_is_made_sharp_at_the_apex() {
+        let (points, normals) = wedge_scan();
+        let edge = find_sharp_edges(&points, &normals)[0];
+        let faces = |tip: &[Vector2<f64>]| -> Vec<Vector2<f64>> {
+            let lower = points[..10].iter();
+            let upper = points[points.len() - 10..].iter();
+            lower.chain(tip).chain(upper).copied().collect()
+        };
+        // A model's tip 12 um beyond the apex, and one rounded 30 um short of it.
+        let beyond = faces(&[
+            Vector2::new(0.008, -0.001),
+            Vector2::new(0.012, 0.0),
+            Vector2::new(0.008, 0.001),
+        ]);
+        let short = faces(&[Vector2::new(-0.03, -0.004), Vector2::new(-0.03, 0.004)]);
+        for outline in [beyond, short] {
+            let sharp = sharpen(&outline, &[edge]);
+            let apex = Vector2::from(edge.apex);
+            let tip = sharp
+                .iter()
+                .position(|p| *p == apex)
+                .expect("the apex is in the outline");
+            // Between the faces: after the lower face's last point, before the upper face's first.
+            let at = |p: &Vector2<f64>| sharp.iter().position(|q| q == p).unwrap();
+            assert!(
+                at(&points[9]) < tip && tip < at(&points[points.len() - 10]),
+                "{sharp:?}"
+            );
+            let farthest = sharp.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max);
+            assert_eq!(farthest, apex.x, "{sharp:?}");
+        }
     }
 
     #[test]

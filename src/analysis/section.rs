@@ -7,6 +7,7 @@ use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::deviation::ProfileGauge;
+use super::edges::{sharpen, SharpEdge};
 use super::tolerances::{AppliedTolerance, Parameter, ParameterVerdict};
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::project_to_zero_set;
@@ -333,13 +334,19 @@ pub(crate) fn nominal_outline(
 }
 
 /// The nominal parameters of a profile model: those of its outline through its taught nominal points `nominals`
-/// (in the profile's plane, in order round it); `Err` says why there are none.
+/// (in the profile's plane, in order round it), made sharp at the master's sharp `edges` (a polynomial rounds
+/// them, or overshoots their apex by microns, where the contacts of a ball rolling round the edge lie on it);
+/// `Err` says why there are none.
 pub(crate) fn nominal_parameters(
     model: &impl Implicit<2>,
     nominals: &[Vector2<f64>],
+    edges: &[SharpEdge],
 ) -> Result<SectionParameters, String> {
-    section_parameters(&nominal_outline(model, nominals), EDGE_DISTANCE_MM)
-        .map_err(|e| format!("its nominal: {e}"))
+    section_parameters(
+        &sharpen(&nominal_outline(model, nominals), edges),
+        EDGE_DISTANCE_MM,
+    )
+    .map_err(|e| format!("its nominal: {e}"))
 }
 
 /// One parameter of a section, nominal and measured (in the unit its name gives).
