@@ -32,6 +32,23 @@ fn scan(truth: &[Truth], radius: f64, normal_error: f64) -> Vec<(Point3<f64>, Ve
         .collect()
 }
 
+/// `path` with Gaussian noise of `sigma` (mm) on each in-plane coordinate of every centre, as a CMM reports it.
+fn with_noise(
+    path: Vec<(Point3<f64>, Vector3<f64>)>,
+    sigma: f64,
+    rng: &mut StdRng,
+) -> Vec<(Point3<f64>, Vector3<f64>)> {
+    let noise = Normal::new(0.0, sigma).unwrap();
+    path.into_iter()
+        .map(|(c, n)| {
+            (
+                c + Vector3::new(noise.sample(rng), noise.sample(rng), 0.0),
+                n,
+            )
+        })
+        .collect()
+}
+
 /// The largest distance from a fitted point to its true contact; panics if fewer than `min_fitted` were fitted.
 fn worst_fitted_error(out: &[Compensated], truth: &[Truth], min_fitted: usize) -> f64 {
     let fitted: Vec<&Compensated> = out
@@ -465,15 +482,11 @@ fn streaming_gives_the_batch_result_with_a_look_ahead_of_four_points() {
 fn with_two_micron_noise_the_contacts_stay_near_the_truth() {
     // The 20 x 10 mm ellipse at 0.1 to 0.2 mm spacing, 1 mm ball, 2 um Gaussian noise on each centre coordinate.
     let truth = ellipse(20.0, 10.0, 700);
-    let mut rng = StdRng::seed_from_u64(2);
-    let noise = Normal::new(0.0, 0.002).unwrap();
-    let path: Vec<(Point3<f64>, Vector3<f64>)> = scan(&truth, 1.0, 0.05)
-        .into_iter()
-        .map(|(c, n)| {
-            let jitter = Vector3::new(noise.sample(&mut rng), noise.sample(&mut rng), 0.0);
-            (c + jitter, n)
-        })
-        .collect();
+    let path = with_noise(
+        scan(&truth, 1.0, 0.05),
+        0.002,
+        &mut StdRng::seed_from_u64(2),
+    );
     let out = compensate_path(CompensationSettings::new(1.0), Vector3::z(), &path, true);
     let (mut worst_normal, mut worst_total, mut sum_sq) = (0.0f64, 0.0f64, 0.0);
     for c in &out {
@@ -670,19 +683,12 @@ fn a_sharp_edge_scanned_at_a_scans_steps_puts_every_contact_of_the_roll_on_the_e
     // ends); from the roll's circle they are within 11 um. A face's contact next to the roll may be taken from the
     // circle: along the face it moves towards the edge, but off it by no more than the noise allows (7 um).
     let mut rng = StdRng::seed_from_u64(11);
-    let noise = Normal::new(0.0, 0.002).unwrap();
     let (mut worst_roll, mut worst_face) = (0.0f64, 0.0f64);
     let mut rolled = 0;
     for _ in 0..40 {
         let half_angle = (5.0 + 10.0 * rng.gen::<f64>()).to_radians();
         let truth = sharp_edge(half_angle, 0.5 + rng.gen::<f64>(), rng.gen());
-        let path: Vec<(Point3<f64>, Vector3<f64>)> = scan(&truth, 1.0, 0.0)
-            .into_iter()
-            .map(|(c, n)| {
-                let jitter = Vector3::new(noise.sample(&mut rng), noise.sample(&mut rng), 0.0);
-                (c + jitter, n)
-            })
-            .collect();
+        let path = with_noise(scan(&truth, 1.0, 0.0), 0.002, &mut rng);
         let out = compensate_path(CompensationSettings::new(1.0), Vector3::z(), &path, false);
         for c in &out[LOOK_AHEAD..out.len() - LOOK_AHEAD] {
             let (x, n) = truth[c.index];
@@ -723,17 +729,7 @@ fn a_small_round_edge_is_found_with_its_radius_and_its_contacts_on_it() {
             Some(along) => (x + along * set_back, n),
         })
         .collect();
-    let mut rng = StdRng::seed_from_u64(5);
-    let noise = Normal::new(0.0, 0.002).unwrap();
-    let path: Vec<(Point3<f64>, Vector3<f64>)> = scan(&truth, 1.0, 0.0)
-        .into_iter()
-        .map(|(c, n)| {
-            (
-                c + Vector3::new(noise.sample(&mut rng), noise.sample(&mut rng), 0.0),
-                n,
-            )
-        })
-        .collect();
+    let path = with_noise(scan(&truth, 1.0, 0.0), 0.002, &mut StdRng::seed_from_u64(5));
     let out = compensate_path(CompensationSettings::new(1.0), Vector3::z(), &path, false);
     let radii: Vec<f64> = out
         .iter()
