@@ -13,9 +13,7 @@
 //! are the errors):
 //! - The nose and tail are the two outline points farthest apart, each moved out along the chord by how far it
 //!   lies behind the tip of its edge's circle where the edge is round (see the edge radius below: a scan's points
-//!   step round a nose, and the farthest of them misses its tip by a few microns), or replaced by the mean of its
-//!   cluster where a ball rolling round a sharp end left one (the farthest of a noisy cluster stands proud of
-//!   it); the chord joins them. The leading edge is the blunter end: the one
+//!   step round a nose, and the farthest of them misses its tip by a few microns); the chord joins them. The leading edge is the blunter end: the one
 //!   whose section is thicker at `EDGE_PROBE` of the chord in from it (an airfoil's round nose against its thin
 //!   tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
@@ -42,11 +40,6 @@ use super::circle::{fit_circle, Circle};
 
 /// Where the ends are told apart: thickness this fraction of the chord in from each end.
 const EDGE_PROBE: f64 = 0.05;
-/// Outline points within this of a sharp end's farthest point are its cluster of contacts (mm): the roll's
-/// contacts scatter by the probe's noise, a few microns; a face's points lie a scan step apart.
-const TIP_CLUSTER_MM: f64 = 0.01;
-/// A sharp end's farthest point is replaced by its cluster's mean when the cluster has this many points.
-const TIP_CLUSTER_POINTS: usize = 3;
 /// Stations along the chord at which the inscribed circles are sampled before the largest is refined.
 const STATIONS: usize = 200;
 /// The golden-section searches stop below this, mm.
@@ -176,24 +169,11 @@ pub(crate) fn section_parameters(
     let zone_mm = edge_distance_mm / 2.0;
     let le_circle = edge_circle(outline, leading_edge, inward, zone_mm);
     let te_circle = edge_circle(outline, trailing_edge, -inward, zone_mm);
-    // A sharp end scanned by a ball rolling round it is a cluster of contacts at one point, each off it by the
-    // probe's noise: the farthest of them stands about two sigmas proud, so the tip is their mean.
-    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| match circle {
-        Some(c) => {
+    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| {
+        circle.map_or(end, |c| {
             let cos_off_tip = (end - c.centre).normalize().dot(&outward);
             end + outward * (c.radius * (1.0 - cos_off_tip))
-        }
-        None => {
-            let cluster: Vec<&Vector2<f64>> = outline
-                .iter()
-                .filter(|p| (*p - end).norm() <= TIP_CLUSTER_MM)
-                .collect();
-            let count = cluster.len();
-            match count >= TIP_CLUSTER_POINTS {
-                true => cluster.into_iter().sum::<Vector2<f64>>() / count as f64,
-                false => end,
-            }
-        }
+        })
     };
     let leading_edge = to_tip(leading_edge, le_circle, -inward);
     let trailing_edge = to_tip(trailing_edge, te_circle, inward);
