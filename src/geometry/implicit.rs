@@ -7,6 +7,7 @@ use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use super::poly::Poly;
+use super::taylor::Taylor;
 
 /// What the distance and sampling code needs of a model: the value and its first and second derivatives.
 pub trait Implicit<const N: usize> {
@@ -18,6 +19,11 @@ pub trait Implicit<const N: usize> {
         &self,
         p: &SVector<f64, N>,
     ) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>);
+    /// The model re-expanded about `at`, for bounds over a box: only polynomials have one, and only they get the
+    /// exact distance's certificate.
+    fn taylor(&self, _at: &SVector<f64, N>) -> Option<Taylor<N>> {
+        None
+    }
 }
 
 impl<const N: usize> Implicit<N> for Poly<N> {
@@ -32,6 +38,9 @@ impl<const N: usize> Implicit<N> for Poly<N> {
         p: &SVector<f64, N>,
     ) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>) {
         Poly::value_gradient_hessian(self, p)
+    }
+    fn taylor(&self, at: &SVector<f64, N>) -> Option<Taylor<N>> {
+        Some(Taylor::of_poly(self, at, 1.0))
     }
 }
 
@@ -116,6 +125,13 @@ impl<const N: usize> Implicit<N> for IpModel<N> {
     ) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>) {
         let (v, g, h) = self.poly.value_gradient_hessian(&self.frame.to_unit(p));
         (self.frame.scale * v, g, h / self.frame.scale)
+    }
+    fn taylor(&self, at: &SVector<f64, N>) -> Option<Taylor<N>> {
+        Some(Taylor::of_poly(
+            &self.poly,
+            &self.frame.to_unit(at),
+            self.frame.scale,
+        ))
     }
 }
 

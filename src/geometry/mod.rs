@@ -16,4 +16,5 @@ pub(crate) mod section_parameters;
 pub mod small;
 pub mod supershape;
 pub mod sweep;
+pub(crate) mod taylor;
 pub mod trace;

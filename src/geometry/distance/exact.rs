@@ -6,8 +6,11 @@
 //! and every answer is checked: the segment from p to the foot must not cross the zero set, and the foot must be no
 //! farther than the on-curve point it started from (the true distance can never be larger than that).
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use nalgebra::{SMatrix, SVector};
 
+use super::certificate::{Certifier, Verdict};
 use super::{DistanceError, Foot};
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{project_to_zero_set, ZeroSetSamples};
@@ -29,20 +32,69 @@ const TAUBIN_AGREEMENT: f64 = 0.02;
 const STEP_TOLERANCE_MM: f64 = 1e-6;
 const MAX_NEWTON_STEPS: usize = 40;
 
-/// Exact distances to the zero set of `f`, seeded from `samples`.
+/// How many times a foot refuted by its certificate is searched for again from the nearer zero it showed.
+const REFUTATIONS_FOLLOWED: usize = 4;
+
+/// Exact distances to the zero set of `f`, seeded from `samples`. Every foot is put to its certificate
+/// ([`super::certificate`]); those it could neither prove nor refute are counted.
 pub struct ExactDistance<'a, F, const N: usize> {
     f: &'a F,
     samples: &'a ZeroSetSamples<N>,
+    uncertified: AtomicUsize,
 }
 
 impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
     pub fn new(f: &'a F, samples: &'a ZeroSetSamples<N>) -> Self {
-        Self { f, samples }
+        Self {
+            f,
+            samples,
+            uncertified: AtomicUsize::new(0),
+        }
+    }
+
+    /// How many feet found so far the certificate could not prove global (a model without a Taylor expansion has
+    /// none proved).
+    pub fn uncertified(&self) -> usize {
+        self.uncertified.load(Ordering::Relaxed)
     }
 
     /// The foot point of `p`. `previous`, when given, is the foot of a neighbouring point along the same scan
     /// together with that point: Newton then starts from the previous foot moved by the step between the points.
     pub fn foot(
+        &self,
+        p: &SVector<f64, N>,
+        previous: Option<(&SVector<f64, N>, &Foot<N>)>,
+    ) -> Result<Foot<N>, DistanceError> {
+        self.certified_foot(p, previous, &mut Certifier::new(self.f))
+    }
+
+    /// The foot found, then put to the certificate: a refuted foot gives way to the one Newton finds from the
+    /// nearer zero the certificate showed.
+    fn certified_foot(
+        &self,
+        p: &SVector<f64, N>,
+        previous: Option<(&SVector<f64, N>, &Foot<N>)>,
+        certifier: &mut Certifier<F, N>,
+    ) -> Result<Foot<N>, DistanceError> {
+        let mut foot = self.found_foot(p, previous)?;
+        for _ in 0..REFUTATIONS_FOLLOWED {
+            match certifier.check(p, &foot.point, foot.distance) {
+                Verdict::Certified => return Ok(foot),
+                Verdict::Nearer(start) => match lagrange_newton(self.f, p, &start) {
+                    Some(nearer) if nearer.distance.abs() < foot.distance.abs() => {
+                        foot = nearer;
+                    }
+                    _ => break,
+                },
+                Verdict::Unknown => break,
+            }
+        }
+        self.uncertified.fetch_add(1, Ordering::Relaxed);
+        Ok(foot)
+    }
+
+    /// The foot the seeded searches find, before its certificate.
+    fn found_foot(
         &self,
         p: &SVector<f64, N>,
         previous: Option<(&SVector<f64, N>, &Foot<N>)>,
@@ -107,12 +159,13 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         points: &[SVector<f64, N>],
     ) -> Vec<Result<Foot<N>, DistanceError>> {
         let mut out: Vec<Result<Foot<N>, DistanceError>> = Vec::with_capacity(points.len());
+        let mut certifier = Certifier::new(self.f);
         for (i, p) in points.iter().enumerate() {
             let previous = match (i.checked_sub(1), out.last()) {
                 (Some(j), Some(Ok(foot))) => Some((&points[j], foot)),
                 _ => None,
             };
-            out.push(self.foot(p, previous));
+            out.push(self.certified_foot(p, previous, &mut certifier));
         }
         out
     }

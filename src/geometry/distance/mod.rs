@@ -6,6 +6,7 @@
 //!   point where its projections reach another branch;
 //! - `Taubin`: the first-order estimate F / |grad F|.
 
+mod certificate;
 mod exact;
 mod paper;
 mod stack;
@@ -13,6 +14,8 @@ mod stack;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
+#[cfg(test)]
+pub(crate) use certificate::{Certifier, Verdict};
 #[cfg(test)]
 pub(crate) use exact::lagrange_newton_to;
 pub use exact::ExactDistance;

@@ -419,6 +419,72 @@ fn the_fast_paths_give_the_models_of_the_dense_path_within_1e_9() {
 }
 
 #[test]
+fn every_local_foot_on_a_fitted_section_but_the_nearest_is_refuted_by_its_certificate() {
+    // Points 0.5-2 mm inside a degree-8 fit of profile 3, near its ends and along its faces: Newton from every
+    // sample of the zero set within 40 mm finds each critical point of the distance (the near face, the far face,
+    // the other side of an end). The certificate must prove the nearest and refute every other one with a zero
+    // nearer than it: the far face's foot is what a local search took for the distance before.
+    use crate::geometry::distance::{lagrange_newton, Certifier, Verdict};
+    use rand::Rng;
+    let truth = profile_3_truth();
+    let measured = noisy(
+        &published_profile_3(),
+        &resample_closed(&truth, 400),
+        0.002,
+        3,
+    );
+    let fitted = fit_profile(&measured, 8, FitMethod::Orthogonal);
+    let model = &fitted.model;
+    let samples = ZeroSetSamples::new(model, &fitted.domain.scaled(2.0), 512);
+    let mut certifier = Certifier::new(model);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(41);
+    let (mut proved, mut refuted) = (0, 0);
+    for _ in 0..300 {
+        let on = truth[rng.gen_range(0..truth.len())];
+        let p = on - model.value_gradient(&on).1.normalize() * rng.gen_range(0.5..2.0);
+        let mut feet: Vec<crate::geometry::distance::Foot<2>> = Vec::new();
+        for s in samples.points().iter().filter(|s| (p - *s).norm() < 40.0) {
+            if let Some(foot) = lagrange_newton(model, &p, s) {
+                if feet.iter().all(|f| (f.point - foot.point).norm() > 1e-6) {
+                    feet.push(foot);
+                }
+            }
+        }
+        let nearest = feet
+            .iter()
+            .map(|f| f.distance.abs())
+            .fold(f64::INFINITY, f64::min);
+        for foot in &feet {
+            let verdict = certifier.check(&p, &foot.point, foot.distance);
+            if foot.distance.abs() <= nearest + 1e-9 {
+                assert_eq!(
+                    verdict,
+                    Verdict::Certified,
+                    "the nearest foot of {p}: {}",
+                    foot.point
+                );
+                proved += 1;
+            } else if foot.distance.abs() > nearest + 1e-6 {
+                match verdict {
+                    Verdict::Nearer(x) => assert!(
+                        (p - x).norm() < foot.distance.abs(),
+                        "at {p}: {x} is no nearer than {}",
+                        foot.point
+                    ),
+                    other => panic!(
+                        "at {p}: the foot {} at {} mm: {other:?}",
+                        foot.point, foot.distance
+                    ),
+                }
+                refuted += 1;
+            }
+        }
+    }
+    assert_eq!(proved, 300);
+    assert!(refuted >= 200, "only {refuted} local feet refuted");
+}
+
+#[test]
 fn exact_distances_of_scattered_points_within_5_mm_are_the_global_minima() {
     // 100 000 points up to 5 mm either side of a degree-8 fit of profile 3, in no order (so that each point's
     // neighbour in the batch is far away), against a dense independent reference: the traced curve at 0.01 mm
@@ -491,4 +557,6 @@ fn exact_distances_of_scattered_points_within_5_mm_are_the_global_minima() {
         }
     }
     assert!(worst.0 < 1e-6, "off by {} mm at {}", worst.0, worst.1);
+    eprintln!("uncertified: {} of {}", exact.uncertified(), points.len());
+    assert_eq!(exact.uncertified(), 0, "feet the certificate left unproved");
 }
