@@ -12,6 +12,7 @@ use super::DistanceArg;
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::{
     signed_distances, DistanceError, DistanceMethod, ExactDistance, StackDistance,
+    CERTIFICATE_TOLERANCE_MM,
 };
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
@@ -51,19 +52,21 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
             args.model.display()
         )
     };
+    // Feet the exact distance's certificate left unproved, where the model has one (implicit polynomials).
+    let mut unproved = None;
     let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) =
         match (&file.model, points) {
             (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
                 let range = m.domain.scaled(RANGE);
                 let distances = within(&range, p, |p| {
-                    distances_to(&m.ip, &range, PROFILE_CELLS, p, method)
+                    distances_to(&m.ip, &range, PROFILE_CELLS, p, method, &mut unproved)
                 });
                 (coordinates(p), distances)
             }
             (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
                 let range = m.domain.scaled(RANGE);
                 let distances = within(&range, p, |p| {
-                    distances_to(&m.ip, &range, SURFACE_CELLS, p, method)
+                    distances_to(&m.ip, &range, SURFACE_CELLS, p, method, &mut unproved)
                 });
                 (coordinates(p), distances)
             }
@@ -126,6 +129,9 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     };
     write_csv(&args.out, header, &rows, &distances)?;
     print_summary(&args.points, &file, method, &distances);
+    if let Some(unproved) = unproved {
+        print_certificates(&distances, unproved);
+    }
     name_points_out_of_range(&point_file.lines, &distances);
     if distances.iter().all(Result::is_err) {
         anyhow::bail!(
@@ -194,22 +200,45 @@ fn coordinates<const N: usize>(points: &[SVector<f64, N>]) -> Vec<Vec<f64>> {
     points.iter().map(|p| p.iter().copied().collect()).collect()
 }
 
+/// Signed distances by `method`; for the exact one, `unproved` is set to how many feet its certificate left
+/// unproved.
 fn distances_to<const N: usize>(
     model: &impl Implicit<N>,
     bounds: &Aabb<N>,
     cells: usize,
     points: &[SVector<f64, N>],
     method: DistanceMethod,
+    unproved: &mut Option<usize>,
 ) -> Vec<Result<f64, DistanceError>> {
     signed_distances(model, points, method, 2.0 * bounds.diagonal(), |points| {
         let samples = ZeroSetSamples::new(model, bounds, cells);
         let exact = ExactDistance::new(model, &samples);
-        exact
+        let distances = exact
             .feet_along_scan(points)
             .into_iter()
             .map(|foot| foot.map(|f| f.distance))
-            .collect()
+            .collect();
+        *unproved = Some(exact.uncertified());
+        distances
     })
+}
+
+/// Says how many exact distances are proved global minima: a Newton foot is only ever a critical point.
+fn print_certificates(distances: &[Result<f64, DistanceError>], unproved: usize) {
+    let measured = distances.iter().filter(|d| d.is_ok()).count();
+    println!(
+        "  certificate: {} of {measured} distances proved the global minimum (no zero of the model nearer, to \
+         {:.0e} mm)",
+        measured.saturating_sub(unproved),
+        CERTIFICATE_TOLERANCE_MM
+    );
+    if unproved > 0 {
+        println!(
+            "  warning: {unproved} distance(s) left unproved: each is the nearest foot the search found, which the \
+             certificate could neither prove nor beat (a point at a centre of curvature, with two feet about \
+             equally near)"
+        );
+    }
 }
 
 fn write_csv(

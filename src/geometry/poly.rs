@@ -114,6 +114,37 @@ impl<const N: usize> Powers<N> {
     }
 }
 
+/// The powers with their first and second derivatives tabulated, e x^(e-1) and e (e-1) x^(e-2) (zero below the
+/// zeroth power), for the Hessian: the exact distance's Newton steps evaluate it at every step, and a table read
+/// per monomial is cheaper there than forming each derivative from the powers with a branch.
+struct PowersWithDerivatives<const N: usize> {
+    value: [[f64; MAX_DEGREE + 1]; N],
+    first: [[f64; MAX_DEGREE + 1]; N],
+    second: [[f64; MAX_DEGREE + 1]; N],
+}
+
+impl<const N: usize> PowersWithDerivatives<N> {
+    #[inline]
+    fn new(p: &SVector<f64, N>, degree: usize) -> Self {
+        let value = Powers::new(p, degree).value;
+        let mut first = [[0.0; MAX_DEGREE + 1]; N];
+        let mut second = [[0.0; MAX_DEGREE + 1]; N];
+        for k in 0..N {
+            for e in 1..=degree {
+                first[k][e] = e as f64 * value[k][e - 1];
+            }
+            for e in 2..=degree {
+                second[k][e] = (e * (e - 1)) as f64 * value[k][e - 2];
+            }
+        }
+        Self {
+            value,
+            first,
+            second,
+        }
+    }
+}
+
 /// A polynomial: coefficients over a [`Basis`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Poly<const N: usize> {
@@ -213,17 +244,15 @@ impl<const N: usize> Poly<N> {
         &self,
         p: &SVector<f64, N>,
     ) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>) {
-        let powers = Powers::<N>::new(p, self.basis.degree);
+        let powers = PowersWithDerivatives::<N>::new(p, self.basis.degree);
         let mut value = 0.0;
         let mut gradient = SVector::<f64, N>::zeros();
         let mut hessian = SMatrix::<f64, N, N>::zeros();
         for (e, &c) in self.basis.exponents.iter().zip(&self.coeffs) {
             let idx: [usize; N] = std::array::from_fn(|k| e[k] as usize);
             let v: [f64; N] = std::array::from_fn(|k| powers.value[k][idx[k]]);
-            let d1: [f64; N] = std::array::from_fn(|k| idx[k] as f64 * powers.get(k, idx[k], 1));
-            let d2: [f64; N] = std::array::from_fn(|k| {
-                (idx[k] * idx[k].saturating_sub(1)) as f64 * powers.get(k, idx[k], 2)
-            });
+            let d1: [f64; N] = std::array::from_fn(|k| powers.first[k][idx[k]]);
+            let d2: [f64; N] = std::array::from_fn(|k| powers.second[k][idx[k]]);
             value += c * v.iter().product::<f64>();
             // Products of the other variables' powers: with N at most 3 these are at most two factors, written
             // out so that the hot path of the exact distance has no loops over filtered indices.

@@ -7,14 +7,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::poly::{binomial, Poly};
+use super::poly::Poly;
 
-/// The Taylor coefficients q_m of a polynomial about a point, stored densely over exponents m with every
-/// m_k <= degree (those above the total degree stay zero).
+/// The Taylor coefficients q_m of a polynomial about a point, each with its exponent m.
 #[derive(Debug, Clone)]
 pub struct Taylor<const N: usize> {
-    degree: usize,
-    coeffs: Vec<f64>,
+    terms: Vec<([usize; N], f64)>,
 }
 
 impl<const N: usize> Taylor<N> {
@@ -27,51 +25,56 @@ impl<const N: usize> Taylor<N> {
         for (e, &c) in poly.basis().exponents().iter().zip(poly.coeffs()) {
             coeffs[dense_index::<N>(e.map(usize::from), side)] = c;
         }
-        // One axis at a time: every line of coefficients along axis k is shifted by at_unit[k]
-        // (x^e = sum_m C(e, m) a^(e - m) (x - a)^m), which keeps each total degree at most what it was.
-        let stride = |k: usize| side.pow(k as u32);
-        let mut line = vec![0.0; side];
+        // One axis at a time: every line of coefficients along axis k is shifted by at_unit[k], in place by
+        // repeated synthetic division (Horner's Taylor shift); a line whose other exponents sum to o holds terms up
+        // to degree - o only, and shifting keeps it so.
         for k in 0..N {
+            let stride = side.pow(k as u32);
             let a = at_unit[k];
-            let powers: Vec<f64> = (0..side).map(|j| a.powi(j as i32)).collect();
             for start in 0..coeffs.len() {
-                if (start / stride(k)) % side != 0 {
+                let exponent = exponent_of::<N>(start, side);
+                let others: usize = exponent.iter().sum();
+                if exponent[k] != 0 || others > degree {
                     continue;
                 }
-                for (j, slot) in line.iter_mut().enumerate() {
-                    *slot = coeffs[start + j * stride(k)];
-                }
-                for m in 0..side {
-                    let shifted: f64 = (m..side)
-                        .map(|e| line[e] * binomial(e, m) as f64 * powers[e - m])
-                        .sum();
-                    coeffs[start + m * stride(k)] = shifted;
+                let top = degree - others;
+                for i in 0..top {
+                    for j in (i..top).rev() {
+                        coeffs[start + j * stride] += a * coeffs[start + (j + 1) * stride];
+                    }
                 }
             }
         }
         // w = scale * (u - at_unit): the coefficient of w^m is q_m = scale * p_m / scale^|m|.
-        for (index, q) in coeffs.iter_mut().enumerate() {
-            let order: usize = exponent_of::<N>(index, side).iter().sum();
-            *q *= scale.powi(1 - order as i32);
-        }
-        Self { degree, coeffs }
-    }
-
-    fn terms(&self) -> impl Iterator<Item = ([usize; N], f64)> + '_ {
-        let side = self.degree + 1;
-        self.coeffs
+        let factors: Vec<f64> = (0..=degree)
+            .scan(scale, |factor, _| {
+                let this = *factor;
+                *factor /= scale;
+                Some(this)
+            })
+            .collect();
+        let terms = coeffs
             .iter()
             .enumerate()
             .filter(|(_, q)| **q != 0.0)
-            .map(move |(index, &q)| (exponent_of::<N>(index, side), q))
+            .filter_map(|(index, &q)| {
+                let m = exponent_of::<N>(index, side);
+                let order: usize = m.iter().sum();
+                (order <= degree).then(|| (m, q * factors[order]))
+            })
+            .collect();
+        Self { terms }
+    }
+
+    fn terms(&self) -> impl Iterator<Item = ([usize; N], f64)> + '_ {
+        self.terms.iter().copied()
     }
 
     fn coeff(&self, m: [usize; N]) -> f64 {
-        let side = self.degree + 1;
-        if m.iter().any(|&e| e >= side) {
-            return 0.0;
-        }
-        self.coeffs[dense_index::<N>(m, side)]
+        self.terms
+            .iter()
+            .find(|(e, _)| *e == m)
+            .map_or(0.0, |(_, q)| *q)
     }
 
     /// F at the expansion point.

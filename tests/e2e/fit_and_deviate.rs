@@ -47,6 +47,10 @@ fn blades_b_and_c_deviate_by_the_simulated_0_8_mm_and_blade_a_by_its_noise() {
         let out = dir.path().join(format!("{blade}.csv"));
         let (values, printed) = deviate(&model, &points, None, &out);
         assert!(printed.contains("n = 400"), "{printed}");
+        assert!(
+            printed.contains("certificate: 400 of 400 distances proved the global minimum"),
+            "{printed}"
+        );
         let values: Vec<f64> = values
             .into_iter()
             .map(|d| d.expect("every exact distance"))

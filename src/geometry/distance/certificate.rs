@@ -25,8 +25,9 @@ use crate::geometry::taylor::Taylor;
 
 /// What a certified foot's distance may exceed the true distance by (mm).
 pub(crate) const TOLERANCE_MM: f64 = 1e-7;
-/// The first ball about a foot is this many times the disk's reach, so that the next feet along a scan fall in it.
-const GENEROUS_BALL: f64 = 2.0;
+/// The balls tried first about a foot, in multiples of the disk's reach: the larger, the more of the next feet
+/// along a scan fall in it and need no expansion of their own.
+const FIRST_BALLS: [f64; 3] = [4.0, 2.0, 1.0];
 /// The smallest local ball tried before boxes, as a fraction of the disk's reach.
 const SMALLEST_BALL: f64 = 1.0 / 64.0;
 /// Boxes examined before a foot is left uncertified (each costs one Taylor expansion, about a microsecond): 4 096
@@ -91,12 +92,24 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
         foot: &SVector<f64, N>,
         distance: f64,
     ) -> Verdict<N> {
+        let (value, gradient) = self.f.value_gradient(foot);
+        self.check_at(p, foot, distance, value, &gradient)
+    }
+
+    /// The same, given the model's value and gradient at the foot.
+    pub(crate) fn check_at(
+        &mut self,
+        p: &SVector<f64, N>,
+        foot: &SVector<f64, N>,
+        distance: f64,
+        value: f64,
+        gradient: &SVector<f64, N>,
+    ) -> Verdict<N> {
         let d = distance.abs();
         if d <= TOLERANCE_MM {
             return Verdict::Certified;
         }
-        let (value, gradient) = self.f.value_gradient(foot);
-        let local = Local::new(p, foot, value, &gradient, d);
+        let local = Local::new(p, foot, value, gradient, d);
         let reach = 2.0 * d;
         if let Some(last) = &self.last {
             if last.covers(foot, reach) && local.proves(last, reach) {
@@ -106,7 +119,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
         let Some(taylor) = self.f.taylor(foot) else {
             return Verdict::Unknown;
         };
-        for radius in [GENEROUS_BALL * reach, reach] {
+        for radius in FIRST_BALLS.map(|multiple| multiple * reach) {
             let bound = HessianBound::of(&taylor, *foot, radius);
             if local.proves(&bound, reach) {
                 self.last = Some(bound);
@@ -291,8 +304,9 @@ impl<const N: usize> Local<N> {
         let n = &self.normal;
         let h = bound.hessian * self.side;
         let e = bound.variation;
-        let tangents = tangents_of(n);
-        let least_bending = least_eigenvalue(&tangents, &h);
+        let basis = tangents_of(n);
+        let tangents = &basis[..N - 1];
+        let least_bending = least_eigenvalue(tangents, &h);
         let cross = tangents
             .iter()
             .map(|t| t.dot(&(h * n)).powi(2))
@@ -315,18 +329,19 @@ impl<const N: usize> Local<N> {
 
 /// An orthonormal basis of the tangent space at a normal `n` (N - 1 vectors), by Gram-Schmidt on the axes least
 /// aligned with it.
-fn tangents_of<const N: usize>(n: &SVector<f64, N>) -> Vec<SVector<f64, N>> {
-    let mut axes: Vec<usize> = (0..N).collect();
-    axes.sort_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()));
-    let mut tangents: Vec<SVector<f64, N>> = Vec::with_capacity(N - 1);
-    for &k in &axes[..N - 1] {
+/// The basis is returned in an array of two; a curve's uses the first only.
+fn tangents_of<const N: usize>(n: &SVector<f64, N>) -> [SVector<f64, N>; 2] {
+    let mut axes: [usize; N] = std::array::from_fn(|k| k);
+    axes.sort_unstable_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()));
+    let mut tangents = [SVector::<f64, N>::zeros(); 2];
+    for (i, &k) in axes[..N - 1].iter().enumerate() {
         let mut t = SVector::<f64, N>::zeros();
         t[k] = 1.0;
         t -= n * n[k];
-        for previous in &tangents {
+        for previous in &tangents[..i] {
             t -= previous * previous.dot(&t);
         }
-        tangents.push(t.normalize());
+        tangents[i] = t.normalize();
     }
     tangents
 }

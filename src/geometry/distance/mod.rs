@@ -14,6 +14,7 @@ mod stack;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
+pub(crate) use certificate::TOLERANCE_MM as CERTIFICATE_TOLERANCE_MM;
 #[cfg(test)]
 pub(crate) use certificate::{Certifier, Verdict};
 #[cfg(test)]

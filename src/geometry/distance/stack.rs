@@ -77,7 +77,9 @@ impl<'a> StackDistance<'a> {
         for j in first..=last {
             let (model, samples) = &self.segments[j];
             let (xa, xb) = (profiles[j].x, profiles[j + 1].x);
-            if let Ok(foot) = ExactDistance::new(model, samples).foot(p, None) {
+            // The segment's polynomial stands for the part only between its planes: a nearer zero beyond them
+            // must not displace the foot within them, so the certificate (over the whole zero set) is not asked.
+            if let Ok(foot) = ExactDistance::new(model, samples).uncertified_foot(p, None) {
                 if foot.point.x >= xa && foot.point.x <= xb {
                     consider(foot);
                 }
