@@ -235,8 +235,8 @@ fn print_certificates(distances: &[Result<f64, DistanceError>], unproved: usize)
     if unproved > 0 {
         println!(
             "  warning: {unproved} distance(s) left unproved: each is the nearest foot the search found, which the \
-             certificate could neither prove nor beat (a point at a centre of curvature, with two feet about \
-             equally near)"
+             certificate could neither prove nor beat within its budget (most often a point on a centre of \
+             curvature, where two feet are about equally near)"
         );
     }
 }

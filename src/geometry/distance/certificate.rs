@@ -19,7 +19,7 @@ use std::collections::BinaryHeap;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::lagrange_newton;
+use super::{lagrange_newton, Foot};
 use crate::geometry::implicit::Implicit;
 use crate::geometry::taylor::Taylor;
 
@@ -43,8 +43,8 @@ const MAX_OTHER_FEET: usize = 8;
 pub(crate) enum Verdict<const N: usize> {
     /// No zero lies nearer to the point than the foot, less [`TOLERANCE_MM`].
     Certified,
-    /// A zero lies nearer than the foot, close to this point: Newton should start again from it.
-    Nearer(SVector<f64, N>),
+    /// A zero lies nearer than the foot: this foot, Newton's from beside it, strictly nearer.
+    Nearer(Foot<N>),
     /// Neither could be shown within the budget (or the model has no Taylor expansion).
     Unknown,
 }
@@ -172,7 +172,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
             let Some(taylor) = self.f.taylor(&centre) else {
                 return Verdict::Unknown;
             };
-            if taylor.value().abs() > taylor.variation(half) {
+            if taylor.value().abs() > taylor.variation(half) + taylor.rounding() {
                 continue;
             }
             if half < smallest {
@@ -181,7 +181,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
                 };
                 let other_d = other.distance.abs();
                 if other_d < d {
-                    return Verdict::Nearer(other.point);
+                    return Verdict::Nearer(other);
                 }
                 let (value, gradient) = self.f.value_gradient(&other.point);
                 let local = Local::new(p, &other.point, value, &gradient, other_d);
@@ -295,6 +295,10 @@ impl<const N: usize> Local<N> {
     /// that sign(d') u'H u >= -K |u|^2 with d K <= G. Only the bending towards p counts: a point outside a convex
     /// nose is certified however far it lies, one inside only short of the centre of curvature.
     fn proves(&self, bound: &HessianBound<N>, extent: f64) -> bool {
+        debug_assert!(
+            extent <= 2.0 * self.d * (1.0 + 1e-12),
+            "the proof holds within 2d"
+        );
         if !(self.gradient_norm > 0.0 && self.gradient_norm.is_finite()) {
             return false;
         }
@@ -323,7 +327,8 @@ impl<const N: usize> Local<N> {
             least_bending * (1.0 - lean * lean)
         };
         let towards_p = -(along - 2.0 * lean * cross - lean * lean * normal - e);
-        self.d * towards_p <= self.gradient_norm
+        // A margin for the rounding of the expansion and of these sums.
+        self.d * towards_p <= self.gradient_norm * (1.0 - 1e-9)
     }
 }
 
@@ -394,7 +399,7 @@ mod tests {
         let far = crate::geometry::distance::lagrange_newton(&model, &p, &far).unwrap();
         assert!(far.distance.abs() > 2.5);
         match certifier.check(&p, &far.point, far.distance) {
-            Verdict::Nearer(x) => assert!((x - near.point).norm() < 1e-3, "{x}"),
+            Verdict::Nearer(x) => assert!((x.point - near.point).norm() < 1e-6, "{}", x.point),
             other => panic!("the far face's foot: {other:?}"),
         }
     }
@@ -407,7 +412,13 @@ mod tests {
         let mut certifier = Certifier::new(&model);
         let p = Vector2::new(1.0, 0.0);
         match certifier.check(&p, &Vector2::new(-2.0, 0.0), -3.0) {
-            Verdict::Nearer(x) => assert!((x - Vector2::new(2.0, 0.0)).norm() < 1e-3, "{x}"),
+            Verdict::Nearer(x) => {
+                assert!(
+                    (x.point - Vector2::new(2.0, 0.0)).norm() < 1e-6,
+                    "{}",
+                    x.point
+                )
+            }
             other => panic!("{other:?}"),
         }
         assert_eq!(

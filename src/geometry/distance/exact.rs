@@ -77,27 +77,33 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         certifier: &mut Certifier<F, N>,
     ) -> Result<Foot<N>, DistanceError> {
         // Along a scan, Newton from the previous foot moved by the step, and nothing else if the certificate
-        // proves it: the checks the search makes on such a foot are all implied by the proof.
+        // proves it: the checks the search makes on such a foot are all implied by the proof. A verdict on it is
+        // kept, so that the search's finding the same foot does not pay for the same proof twice.
+        let mut judged: Option<(SVector<f64, N>, Verdict<N>)> = None;
+        let mut refuted_by = None;
         if let Some((prev_point, prev_foot)) = previous {
             let start = prev_foot.point + (p - prev_point);
             if let Some(c) = lagrange_newton_with_gradient(self.f, p, &start, STEP_TOLERANCE_MM) {
-                let verdict =
-                    certifier.check_at(p, &c.foot.point, c.foot.distance, c.value, &c.gradient);
-                if verdict == Verdict::Certified {
-                    return Ok(c.foot);
+                match certifier.check_at(p, &c.foot.point, c.foot.distance, c.value, &c.gradient) {
+                    Verdict::Certified => return Ok(c.foot),
+                    Verdict::Nearer(nearer) => refuted_by = Some(nearer),
+                    Verdict::Unknown => judged = Some((c.foot.point, Verdict::Unknown)),
                 }
             }
         }
-        let mut foot = self.uncertified_foot(p, previous)?;
+        let mut foot = match refuted_by {
+            Some(nearer) => nearer,
+            None => self.uncertified_foot(p, previous)?,
+        };
         for _ in 0..REFUTATIONS_FOLLOWED {
-            match certifier.check(p, &foot.point, foot.distance) {
+            let verdict = match judged.take() {
+                Some((point, verdict)) if (point - foot.point).norm() <= 1e-9 => verdict,
+                _ => certifier.check(p, &foot.point, foot.distance),
+            };
+            match verdict {
                 Verdict::Certified => return Ok(foot),
-                Verdict::Nearer(start) => match lagrange_newton(self.f, p, &start) {
-                    Some(nearer) if nearer.distance.abs() < foot.distance.abs() => {
-                        foot = nearer;
-                    }
-                    _ => break,
-                },
+                // Strictly nearer, by the certificate's own Newton run: following it always makes progress.
+                Verdict::Nearer(nearer) => foot = nearer,
                 Verdict::Unknown => break,
             }
         }
@@ -275,13 +281,16 @@ pub(crate) fn lagrange_newton_to<const N: usize>(
 /// A foot with the model's value and gradient there, for its certificate.
 pub(crate) struct Converged<const N: usize> {
     pub(crate) foot: Foot<N>,
+    /// A bound on |F| at the foot.
     pub(crate) value: f64,
     pub(crate) gradient: SVector<f64, N>,
 }
 
-/// Newton's method on the Lagrange system; the value and gradient at the foot are the last evaluation's carried
-/// through the final step to first order (F + g.dx, g + H dx): their error is of the order of the step's square,
-/// below 1e-12 at a final step under 1e-6 mm, where the certificate allows 1e-8.
+/// Newton's method on the Lagrange system, with the value and gradient at the foot: the last evaluation's carried
+/// through the final step (g + H dx, whose error is of the order of the step's square, below 1e-12 at a final step
+/// under 1e-6 mm). The value there is F + g.dx + dx'H dx / 2 to second order, and F + g.dx is zero by the step's
+/// own constraint row, so what is handed on is a bound: twice the second-order term's size, |H| |dx|^2, against
+/// the 1e-8 mm the certificate allows.
 pub(crate) fn lagrange_newton_with_gradient<const N: usize>(
     f: &impl Implicit<N>,
     p: &SVector<f64, N>,
@@ -321,7 +330,7 @@ pub(crate) fn lagrange_newton_with_gradient<const N: usize>(
             // The last step's gradient is the foot's to within the step: it tells the side.
             return signed_foot(p, x, &g).map(|foot| Converged {
                 foot,
-                value: v + g.dot(&dx),
+                value: (v + g.dot(&dx)).abs() + h.norm() * dx.norm_squared(),
                 gradient: g + h * dx,
             });
         }

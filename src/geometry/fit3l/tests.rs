@@ -466,11 +466,15 @@ fn every_local_foot_on_a_fitted_section_but_the_nearest_is_refuted_by_its_certif
                 proved += 1;
             } else if foot.distance.abs() > nearest + 1e-6 {
                 match verdict {
-                    Verdict::Nearer(x) => assert!(
-                        (p - x).norm() < foot.distance.abs(),
-                        "at {p}: {x} is no nearer than {}",
-                        foot.point
-                    ),
+                    Verdict::Nearer(x) => {
+                        assert!(
+                            (p - x.point).norm() < foot.distance.abs(),
+                            "at {p}: {} is no nearer than {}",
+                            x.point,
+                            foot.point
+                        );
+                        assert!(model.value(&x.point).abs() < 1e-9, "at {p}: off the curve");
+                    }
                     other => panic!(
                         "at {p}: the foot {} at {} mm: {other:?}",
                         foot.point, foot.distance
