@@ -29,6 +29,15 @@ impl<const N: usize> Taylor<N> {
         }
         // The shift adds terms c_e C(e, m) a^(e - m): each coefficient's rounding error is a few epsilons of the sum
         // of their sizes, at most sum_e |c_e| prod_k (1 + |a_k|)^e_k, times the number of additions.
+        let growth: [Vec<f64>; N] = std::array::from_fn(|k| {
+            (0..side)
+                .scan(1.0, |power, _| {
+                    let this = *power;
+                    *power *= 1.0 + at_unit[k].abs();
+                    Some(this)
+                })
+                .collect()
+        });
         let size: f64 = poly
             .basis()
             .exponents()
@@ -37,7 +46,7 @@ impl<const N: usize> Taylor<N> {
             .map(|(e, c)| {
                 c.abs()
                     * (0..N)
-                        .map(|k| (1.0 + at_unit[k].abs()).powi(i32::from(e[k])))
+                        .map(|k| growth[k][usize::from(e[k])])
                         .product::<f64>()
             })
             .sum();

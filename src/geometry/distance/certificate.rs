@@ -30,10 +30,26 @@ pub(crate) const TOLERANCE_MM: f64 = 1e-7;
 const FIRST_BALLS: [f64; 3] = [4.0, 2.0, 1.0];
 /// The smallest local ball tried before boxes, as a fraction of the disk's reach.
 const SMALLEST_BALL: f64 = 1.0 / 64.0;
-/// Boxes examined before a foot is left uncertified (each costs one Taylor expansion, about a microsecond): 4 096
-/// for a curve, 65 536 for a surface, whose boxes split in eight and cover an area, not a line.
+/// Boxes examined before a foot is left uncertified (each costs one Taylor expansion, one to a few microseconds):
+/// 512 for a curve, where the station measures every point live and a sharp edge's sliver would otherwise cost
+/// milliseconds a point, and 65 536 for a surface, whose boxes split in eight and cover an area, not a line.
 const fn box_budget(n: usize) -> usize {
-    16 << (4 * n)
+    if n == 2 {
+        512
+    } else {
+        65_536
+    }
+}
+
+/// A box this small, as a fraction of the distance, is no longer halved: Newton from its centre finds the zero in
+/// it or next to it, which either refutes the foot or is proved as a second foot. A curve's boxes stop sooner (the
+/// station measures every point live); a surface's go finer, where a second foot's ball must hold the box.
+const fn smallest_box(n: usize) -> f64 {
+    if n == 2 {
+        1e-2
+    } else {
+        1e-4
+    }
 }
 /// Other critical points of the distance, about as near as the foot, whose balls the boxes may leave out.
 const MAX_OTHER_FEET: usize = 8;
@@ -154,7 +170,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
     /// not, and then its own ball is proved and left out like the foot's (two feet equally near, across a
     /// medial axis).
     fn boxes(&self, p: &SVector<f64, N>, foot: &SVector<f64, N>, d: f64, ball: f64) -> Verdict<N> {
-        let smallest = 1e-4 * d;
+        let smallest = smallest_box(N) * d;
         let mut balls = vec![(*foot, ball)];
         let mut queue = BinaryHeap::from([Cube::new(p, *p, d)]);
         let mut examined = 0;
