@@ -7,6 +7,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::fsutil::write_atomically;
+use crate::geometry::faces::{FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::FitStats;
 use crate::geometry::implicit::IpModel;
 use crate::geometry::interp::{Profile, ProfileStack, StackError};
@@ -47,6 +48,10 @@ pub enum ReferenceModel {
     /// Parallel profiles along x blended linearly into a piecewise 3-D model (seed 003 section 4).
     #[serde(rename = "ip-stack")]
     Stack { profiles: Vec<StackProfile> },
+    /// One planar profile in the (y, z) plane split at its sharp edges into faces, an implicit polynomial each,
+    /// joined where they meet (`geometry::faces`).
+    #[serde(rename = "ip-faces")]
+    Faces(FacedIp),
     /// A CSG tree of supershapes (seeds 000 and 001) with the statistics of its fit.
     #[serde(rename = "supershape")]
     Supershape {
@@ -55,7 +60,8 @@ pub enum ReferenceModel {
     },
 }
 
-/// How closely a supershape model follows the points it was made from: exact distances, mm.
+/// How closely a supershape model, or a profile of faces, follows the points it was made from: exact distances,
+/// mm.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolidFitStats {
@@ -131,6 +137,52 @@ impl<const N: usize> FittedIp<N> {
     }
 }
 
+/// A profile of faces: each face's polynomial with the box of its points and its statistics, counter-clockwise
+/// round the part; `joins[j]` is where face j ends and the next begins.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FacedIp {
+    pub faces: Vec<FittedIp<2>>,
+    pub joins: Vec<Join>,
+    /// The whole profile's distances to the fitted points.
+    pub fit: Option<SolidFitStats>,
+}
+
+impl FacedIp {
+    /// The box of every face's points, mm.
+    pub fn domain(&self) -> Aabb<2> {
+        let mut domain = self.faces[0].domain;
+        for face in &self.faces[1..] {
+            domain.min = domain.min.inf(&face.domain.min);
+            domain.max = domain.max.sup(&face.domain.max);
+        }
+        domain
+    }
+
+    /// The model to measure with: the faces traced from join to join.
+    pub fn profile(&self) -> Result<FacedProfile, FacesError> {
+        FacedProfile::new(
+            self.faces.iter().map(|f| f.ip.clone()).collect(),
+            self.joins.clone(),
+            &self.domain(),
+        )
+    }
+
+    fn check(&self) -> Result<(), String> {
+        if self.faces.len() < 2 || self.joins.len() != self.faces.len() {
+            return Err(format!(
+                "a profile of faces needs two or more faces and a join per face; it has {} faces and {} joins",
+                self.faces.len(),
+                self.joins.len()
+            ));
+        }
+        for (j, face) in self.faces.iter().enumerate() {
+            face.check().map_err(|e| format!("face {j}: {e}"))?;
+        }
+        self.profile().map(drop).map_err(|e| e.to_string())
+    }
+}
+
 /// One profile of a stack: its position along x (mm) and its fitted (y, z) model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -197,6 +249,7 @@ impl ModelFile {
                 })
                 .and_then(|()| stack_of(profiles).map(drop).map_err(|e| e.to_string())),
             ReferenceModel::Supershape { solid, .. } => check_solid(solid),
+            ReferenceModel::Faces(faced) => faced.check(),
         };
         checked.map_err(|problem| ModelFileError::new(path, problem))?;
         Ok(file)

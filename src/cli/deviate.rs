@@ -54,74 +54,101 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     };
     // Feet the exact distance's certificate left unproved, where the model has one (implicit polynomials).
     let mut unproved = None;
-    let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) =
-        match (&file.model, points) {
-            (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
-                let range = m.domain.scaled(RANGE);
-                let distances = within(&range, p, |p| {
-                    distances_to(&m.ip, &range, PROFILE_CELLS, p, method, &mut unproved)
-                });
-                (coordinates(p), distances)
-            }
-            (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
-                let range = m.domain.scaled(RANGE);
-                let distances = within(&range, p, |p| {
-                    distances_to(&m.ip, &range, SURFACE_CELLS, p, method, &mut unproved)
-                });
-                (coordinates(p), distances)
-            }
-            (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
-                let stack =
-                    stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
-                // The stack sorts its profiles along x; pair each with its own domain in that order.
-                let mut sorted = profiles.clone();
-                sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
-                let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
-                let range = stack.bounds(&domains).scaled(RANGE);
-                let reach = 2.0 * range.diagonal();
-                let distances = within(&range, p, |p| {
-                    signed_distances(&stack, p, method, reach, |points| {
-                        let exact = StackDistance::new(&stack, &domains);
-                        points
-                            .iter()
-                            .map(|q| exact.foot(q).map(|f| f.distance))
-                            .collect()
-                    })
-                });
-                (coordinates(p), distances)
-            }
-            (ReferenceModel::Supershape { solid, .. }, PointSet::Spatial(p)) => {
-                if method != DistanceMethod::Exact {
-                    anyhow::bail!(
-                        "{}: a supershape model is measured by the exact Euclidean distance only; \
+    let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) = match (
+        &file.model,
+        points,
+    ) {
+        (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
+            let range = m.domain.scaled(RANGE);
+            let distances = within(&range, p, |p| {
+                distances_to(&m.ip, &range, PROFILE_CELLS, p, method, &mut unproved)
+            });
+            (coordinates(p), distances)
+        }
+        (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
+            let range = m.domain.scaled(RANGE);
+            let distances = within(&range, p, |p| {
+                distances_to(&m.ip, &range, SURFACE_CELLS, p, method, &mut unproved)
+            });
+            (coordinates(p), distances)
+        }
+        (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
+            let stack = stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+            // The stack sorts its profiles along x; pair each with its own domain in that order.
+            let mut sorted = profiles.clone();
+            sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
+            let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
+            let range = stack.bounds(&domains).scaled(RANGE);
+            let reach = 2.0 * range.diagonal();
+            let distances = within(&range, p, |p| {
+                signed_distances(&stack, p, method, reach, |points| {
+                    let exact = StackDistance::new(&stack, &domains);
+                    points
+                        .iter()
+                        .map(|q| exact.foot(q).map(|f| f.distance))
+                        .collect()
+                })
+            });
+            (coordinates(p), distances)
+        }
+        (ReferenceModel::Supershape { solid, .. }, PointSet::Spatial(p)) => {
+            if method != DistanceMethod::Exact {
+                anyhow::bail!(
+                    "{}: a supershape model is measured by the exact Euclidean distance only; \
                          leave out --distance or give --distance exact",
+                    args.model.display()
+                );
+            }
+            let exact = SolidDistance::new(solid);
+            let bounds = solid.bounds();
+            let range = Aabb {
+                min: bounds.min.coords,
+                max: bounds.max.coords,
+            }
+            .scaled(RANGE);
+            let distances = within(&range, p, |p| {
+                p.iter()
+                    .map(|q| {
+                        exact
+                            .foot(&nalgebra::Point3::from(*q))
+                            .map(|f| f.distance_mm)
+                            .ok_or(DistanceError::NoFootPoint)
+                    })
+                    .collect()
+            });
+            (coordinates(p), distances)
+        }
+        (ReferenceModel::Faces(faced), PointSet::Profile(p)) => {
+            if method != DistanceMethod::Exact {
+                anyhow::bail!(
+                        "{}: a profile of faces is measured by the exact Euclidean distance only (its sharp edges \
+                         have no first-order estimate); leave out --distance or give --distance exact",
                         args.model.display()
                     );
-                }
-                let exact = SolidDistance::new(solid);
-                let bounds = solid.bounds();
-                let range = Aabb {
-                    min: bounds.min.coords,
-                    max: bounds.max.coords,
-                }
-                .scaled(RANGE);
-                let distances = within(&range, p, |p| {
-                    p.iter()
-                        .map(|q| {
-                            exact
-                                .foot(&nalgebra::Point3::from(*q))
-                                .map(|f| f.distance_mm)
-                                .ok_or(DistanceError::NoFootPoint)
-                        })
-                        .collect()
-                });
-                (coordinates(p), distances)
             }
-            (ReferenceModel::Profile(_), PointSet::Spatial(_)) => {
-                return Err(mismatch("a profile", "y,z", "x,y,z"))
-            }
-            (_, PointSet::Profile(_)) => return Err(mismatch("3-D", "x,y,z", "y,z")),
-        };
+            let profile = faced
+                .profile()
+                .map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+            let range = faced.domain().scaled(RANGE);
+            // Every foot the faces give is proved nearest by the traced faces' bound, or there is none.
+            unproved = Some(0);
+            let distances = within(&range, p, |p| {
+                p.iter()
+                    .map(|q| {
+                        profile
+                            .foot(q)
+                            .map(|f| f.distance)
+                            .ok_or(DistanceError::NoFootPoint)
+                    })
+                    .collect()
+            });
+            (coordinates(p), distances)
+        }
+        (ReferenceModel::Profile(_) | ReferenceModel::Faces(_), PointSet::Spatial(_)) => {
+            return Err(mismatch("a profile", "y,z", "x,y,z"))
+        }
+        (_, PointSet::Profile(_)) => return Err(mismatch("3-D", "x,y,z", "y,z")),
+    };
     let header: &[&str] = if rows[0].len() == 2 {
         &["y", "z"]
     } else {

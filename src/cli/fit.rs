@@ -9,10 +9,13 @@ use nalgebra::{SVector, Vector2, Vector3};
 
 use super::{all_rows, MethodArg};
 use crate::analysis::fit_sanity;
+use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitOptions, Fitted};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
-use crate::model_file::{FittedIp, ModelFile, ReferenceModel, StackProfile};
+use crate::model_file::{
+    FacedIp, FittedIp, ModelFile, ReferenceModel, SolidFitStats, StackProfile,
+};
 use crate::points::{read_point_file, PointFile, PointSet};
 
 #[derive(Args)]
@@ -20,9 +23,15 @@ pub struct FitIpArgs {
     /// Point file: CSV with header y,z (a profile) or x,y,z (3-D), in mm.
     #[arg(long)]
     points: PathBuf,
-    /// Degree of the polynomial (of each profile, for a stack), 1 to 16.
-    #[arg(long, default_value_t = 4, value_parser = degree)]
-    degree: usize,
+    /// Degree of the polynomial (of each profile, for a stack; of each face, for a profile with sharp edges), 1 to
+    /// 16. By default 4; a face's is chosen from 4, 6 and 8 by the points held out of its fit.
+    #[arg(long, value_parser = degree)]
+    degree: Option<usize>,
+    /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
+    /// along the profile) and fits the faces between them one by one, joined at the edges; `none` fits one
+    /// polynomial round the whole profile, which rounds or overshoots a sharp edge by tens of microns.
+    #[arg(long, value_enum, default_value = "auto")]
+    edges: EdgesArg,
     #[arg(long, value_enum, default_value = "odr")]
     method: MethodArg,
     /// Where the outward normals for the 3L offsets come from.
@@ -67,6 +76,15 @@ fn degree(text: &str) -> Result<usize, String> {
     }
 }
 
+/// The degree of a polynomial when none is given and none is chosen by the data.
+const DEFAULT_DEGREE: usize = 4;
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum EdgesArg {
+    Auto,
+    None,
+}
+
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum NormalsArg {
     /// From the order of the points when they run along the profile, else by local PCA.
@@ -81,8 +99,21 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let file = read_point_file(&args.points)?;
     warn_of_isolated_points(&file);
-    let options = FitOptions::new(args.degree, args.method.into());
+    let options = FitOptions::new(args.degree.unwrap_or(DEFAULT_DEGREE), args.method.into());
     let (model, method) = match (file.points, args.stack) {
+        (PointSet::Profile(points), false) if with_faces(args, &points) => {
+            match fit_faces_of(args, &points)? {
+                Some(faced) => (ReferenceModel::Faces(faced), options.method),
+                None => {
+                    let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
+                    print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
+                    (
+                        ReferenceModel::Profile(into_file(fitted.clone())),
+                        fitted.method,
+                    )
+                }
+            }
+        }
         (PointSet::Profile(points), false) => {
             let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
             print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
@@ -131,6 +162,91 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Whether to look for sharp edges: asked for, and the points run along the profile (the edges are found in
+/// their order).
+fn with_faces(args: &FitIpArgs, points: &[Vector2<f64>]) -> bool {
+    args.edges == EdgesArg::Auto
+        && args.normals != NormalsArg::Pca
+        && points.len() >= 3
+        && runs_along_the_profile(points)
+}
+
+/// The profile fitted face by face between its sharp edges, with what was found and fitted said; `None` when it
+/// has no sharp edge. A fit that misses `--tolerance` fails rather than being saved.
+fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Option<FacedIp>> {
+    let options = FacesFitOptions {
+        degree: args.degree,
+        method: args.method.into(),
+    };
+    let Some(fitted) =
+        fit_faces(points, &options).map_err(|e| anyhow!("{}: {e}", args.points.display()))?
+    else {
+        return Ok(None);
+    };
+    let edges: Vec<String> = fitted
+        .model
+        .joins()
+        .iter()
+        .filter(|j| j.sharp)
+        .map(|j| format!("({:.3}, {:.3})", j.point[0], j.point[1]))
+        .collect();
+    println!(
+        "{}: {} sharp edge(s) at {} mm: fitted face by face, {} faces joined at the edges (--edges none for one \
+         polynomial)",
+        args.points.display(),
+        edges.len(),
+        edges.join(", "),
+        fitted.faces.len()
+    );
+    for (j, (face, held_out)) in fitted.faces.iter().zip(&fitted.held_out).enumerate() {
+        let chosen = if held_out.is_empty() {
+            "given".to_string()
+        } else {
+            let scores: Vec<String> = held_out
+                .iter()
+                .map(|(d, rms)| format!("{d}: {:.2} um", rms * 1000.0))
+                .collect();
+            format!("chosen by held-out RMS, {}", scores.join(", "))
+        };
+        println!(
+            "  face {j}: degree {} ({chosen}), {} points, RMS {:.4} mm, max {:.4} mm",
+            face.model.degree(),
+            face.stats.points,
+            face.stats.rms_distance_mm,
+            face.stats.max_distance_mm
+        );
+    }
+    let distances: Vec<f64> = points
+        .iter()
+        .map(|p| fitted.model.foot(p).map_or(f64::INFINITY, |f| f.distance))
+        .collect();
+    let stats = SolidFitStats {
+        points: distances.len(),
+        rms_distance_mm: (distances.iter().map(|d| d * d).sum::<f64>() / distances.len() as f64)
+            .sqrt(),
+        max_distance_mm: distances.iter().fold(0.0, |m, d| m.max(d.abs())),
+    };
+    println!(
+        "  distance of the fitted points to the joined faces: RMS {:.4} mm, max {:.4} mm",
+        stats.rms_distance_mm, stats.max_distance_mm
+    );
+    if let Some(tolerance) = args.tolerance {
+        if stats.max_distance_mm > tolerance {
+            bail!(
+                "{}: the faces' fit reaches {:.4} mm at worst, beyond the part's tolerance of {tolerance} mm: no \
+                 model saved; check the points for strays, or give --degree",
+                args.points.display(),
+                stats.max_distance_mm
+            );
+        }
+    }
+    Ok(Some(FacedIp {
+        faces: fitted.faces.into_iter().map(into_file).collect(),
+        joins: fitted.model.joins().to_vec(),
+        fit: Some(stats),
+    }))
 }
 
 fn into_file<const N: usize>(fitted: Fitted<N>) -> FittedIp<N> {

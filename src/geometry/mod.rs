@@ -3,6 +3,7 @@
 
 pub(crate) mod circle;
 pub mod distance;
+pub mod faces;
 pub mod fit3l;
 pub mod implicit;
 pub mod interp;

@@ -1,0 +1,157 @@
+//! Fitting a profile with sharp edges face by face, each face's degree chosen by points it was not fitted to.
+
+use nalgebra::Vector2;
+
+use super::split::{
+    face_normals, find_corners, joint_of, orientation, perimeter_mm, split_at_corners,
+};
+use super::{meeting_point, FacedProfile, FacesError, Join};
+use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
+use crate::geometry::implicit::Implicit;
+use crate::geometry::sampling::{project_to_zero_set, Aabb};
+
+/// The degrees a face's fit chooses from when none is given.
+pub const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
+/// A higher degree is chosen only when its held-out RMS is below this fraction of the lower one's: noise alone
+/// moves a held-out RMS by a few percent.
+const HIGHER_DEGREE_GAIN: f64 = 0.9;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FacesFitOptions {
+    /// Every face's degree; `None` to choose each face's from [`CANDIDATE_DEGREES`] by a held-out check.
+    pub degree: Option<usize>,
+    pub method: FitMethod,
+}
+
+/// A profile fitted face by face.
+pub struct FittedFaces {
+    /// Each face's fit, counter-clockwise round the part.
+    pub faces: Vec<Fitted<2>>,
+    /// For each face, the held-out RMS distance (mm) of each candidate degree tried, when the degree was chosen.
+    pub held_out: Vec<Vec<(usize, f64)>>,
+    pub model: FacedProfile,
+    /// The box of the fitted points, mm.
+    pub domain: Aabb<2>,
+}
+
+/// Fits a closed profile whose points run along it face by face, split at its sharp edges. `Ok(None)` when it
+/// has no sharp edge (one polynomial then serves).
+pub fn fit_faces(
+    points: &[Vector2<f64>],
+    options: &FacesFitOptions,
+) -> Result<Option<FittedFaces>, FacesError> {
+    // Counter-clockwise, so that faces and joins follow the model's own direction round the part.
+    let counter_clockwise: Vec<Vector2<f64>> = if orientation(points) > 0.0 {
+        points.to_vec()
+    } else {
+        points.iter().rev().copied().collect()
+    };
+    let points = &counter_clockwise[..];
+    let corners = find_corners(points);
+    if corners.is_empty() {
+        return Ok(None);
+    }
+    let faces = split_at_corners(points, &corners);
+    let perimeter = perimeter_mm(points);
+    let mut fitted = Vec::with_capacity(faces.len());
+    let mut held_out = Vec::with_capacity(faces.len());
+    for (j, face) in faces.iter().enumerate() {
+        let face_points: Vec<Vector2<f64>> = face.indices.iter().map(|&i| points[i]).collect();
+        let normals = face_normals(points, &face.indices, 1.0, perimeter);
+        let fit = |degree: usize, every: usize, from: usize| {
+            let (p, n): (Vec<_>, Vec<_>) = face_points
+                .iter()
+                .zip(&normals)
+                .skip(from)
+                .step_by(every)
+                .map(|(p, n)| (*p, *n))
+                .unzip();
+            fit_ip(&p, &n, &FitOptions::new(degree, options.method))
+                .map_err(|source| FacesError::Fit { face: j, source })
+        };
+        let (degree, scores) = match options.degree {
+            Some(degree) => (degree, Vec::new()),
+            None => {
+                let mut scores = Vec::new();
+                for degree in CANDIDATE_DEGREES {
+                    // Fitted to every other point, judged by the others.
+                    if let Ok(trained) = fit(degree, 2, 0) {
+                        let judged: Vec<Vector2<f64>> =
+                            face_points.iter().skip(1).step_by(2).copied().collect();
+                        scores.push((degree, rms_distance(&trained.model, &judged)));
+                    }
+                }
+                (choose_degree(&scores), scores)
+            }
+        };
+        fitted.push(fit(degree, 1, 0)?);
+        held_out.push(scores);
+    }
+    let n = faces.len();
+    let mut joins = Vec::with_capacity(n);
+    for j in 0..n {
+        let next = (j + 1) % n;
+        let (before, after) = (&fitted[j].model, &fitted[next].model);
+        let join = if faces[j].sharp_end {
+            let apex = points[faces[next].indices[0]];
+            let point = meeting_point(before, after, &apex).ok_or(FacesError::NoMeeting {
+                before: j,
+                after: next,
+                at: apex.into(),
+            })?;
+            Join {
+                point: point.into(),
+                sharp: true,
+            }
+        } else {
+            let joint = points[joint_of(&faces).expect("a one-edge profile has a joint")];
+            let on = |f: &crate::geometry::implicit::IpModel<2>| {
+                project_to_zero_set(f, &joint, super::JOIN_SEARCH_MM).unwrap_or(joint)
+            };
+            Join {
+                point: ((on(before) + on(after)) / 2.0).into(),
+                sharp: false,
+            }
+        };
+        joins.push(join);
+    }
+    let domain = Aabb::of_points(points).expect("a profile with an edge has points");
+    let model = FacedProfile::new(
+        fitted.iter().map(|f| f.model.clone()).collect(),
+        joins,
+        &domain,
+    )?;
+    Ok(Some(FittedFaces {
+        faces: fitted,
+        held_out,
+        model,
+        domain,
+    }))
+}
+
+/// The lowest degree whose held-out RMS no higher degree beats by more than noise does.
+fn choose_degree(scores: &[(usize, f64)]) -> usize {
+    let mut chosen = scores
+        .first()
+        .copied()
+        .unwrap_or((CANDIDATE_DEGREES[0], 0.0));
+    for &(degree, rms) in &scores[1.min(scores.len())..] {
+        if rms < HIGHER_DEGREE_GAIN * chosen.1 {
+            chosen = (degree, rms);
+        }
+    }
+    chosen.0
+}
+
+/// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
+/// the model, where the first-order distance is exact to second order.
+fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
+    let sum: f64 = points
+        .iter()
+        .map(|p| {
+            let (v, g) = model.value_gradient(p);
+            (v / g.norm()).powi(2)
+        })
+        .sum();
+    (sum / points.len() as f64).sqrt()
+}
