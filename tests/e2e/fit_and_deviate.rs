@@ -1,6 +1,11 @@
 //! Fitting the master's points and measuring the other blades against the model, through the binary.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector2;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use zeroset_sim::naca::Naca4;
 
 use crate::support::{config, deviate, fit_ip, mean};
 
@@ -198,6 +203,98 @@ fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
         values.iter().all(|d| (d - 0.25).abs() < 0.001),
         "an offset of 0.25 mm everywhere: {:?}",
         &values[..5]
+    );
+}
+
+/// Points of a NACA section with a sharp trailing edge written as a y,z file: `count` round it, each moved along
+/// its normal by `offset` mm and by seeded Gaussian noise of `sigma` mm.
+fn naca_csv(path: &Path, foil: &Naca4, count: usize, offset: f64, sigma: f64, seed: u64) {
+    let points: Vec<Vector2<f64>> = foil.points(count).into_iter().map(Vector2::from).collect();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, sigma.max(f64::MIN_POSITIVE)).unwrap();
+    let n = points.len();
+    let mut text = String::from("y,z\n");
+    for i in 0..n {
+        let tangent = points[(i + 1) % n] - points[(i + n - 1) % n];
+        let normal = Vector2::new(tangent.y, -tangent.x).normalize();
+        let p = points[i] + normal * (offset + noise.sample(&mut rng));
+        text.push_str(&format!("{:.7},{:.7}\n", p.x, p.y));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn a_sharp_trailing_edge_is_fitted_face_by_face_and_measured_to_the_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let foil = Naca4::from_digits("6412", 250.0, true).unwrap();
+    let scan = dir.path().join("scan.csv");
+    naca_csv(&scan, &foil, 400, 0.0, 0.002, 42);
+    let model = dir.path().join("faces.json");
+    let (fit, saved) = fit_ip(scan.to_str().unwrap(), &[], &model);
+    assert!(fit.contains("1 sharp edge(s) at ("), "{fit}");
+    assert!(fit.contains("3 faces joined at the edges"), "{fit}");
+    assert!(fit.contains("chosen by held-out RMS"), "{fit}");
+    assert_eq!(saved["model"]["kind"], "ip-faces");
+    assert_eq!(saved["model"]["faces"].as_array().unwrap().len(), 3);
+    let edge = saved["model"]["joins"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|j| j["sharp"] == true)
+        .expect("the trailing edge");
+    let (y, z) = (
+        edge["point"][0].as_f64().unwrap(),
+        edge["point"][1].as_f64().unwrap(),
+    );
+    assert!(
+        (y - 250.0).hypot(z) < 0.01,
+        "the trailing edge at ({y}, {z}) mm"
+    );
+    // The true section, densely (cosine-spaced: crowded at both edges), lies within 5 um of the model.
+    let truth = dir.path().join("truth.csv");
+    naca_csv(&truth, &foil, 4000, 0.0, 0.0, 0);
+    let (values, printed) = deviate(
+        &model,
+        truth.to_str().unwrap(),
+        None,
+        &dir.path().join("t.csv"),
+    );
+    assert!(
+        printed.contains("certificate: 4000 of 4000 distances proved"),
+        "{printed}"
+    );
+    let truth_worst = largest(&values.into_iter().map(|d| d.unwrap()).collect::<Vec<_>>());
+    assert!(
+        truth_worst < 0.005,
+        "the true section is {truth_worst} mm from the model"
+    );
+    // Round the edge, 0.1 mm out, in its normal cone: the edge itself is the nearest point of the part.
+    let beyond = dir.path().join("beyond.csv");
+    let mut text = String::from("y,z\n");
+    for degrees in [-60.0f64, -30.0, 0.0, 30.0, 60.0] {
+        let (sin, cos) = degrees.to_radians().sin_cos();
+        text.push_str(&format!("{},{}\n", 250.0 + 0.1 * cos, 0.1 * sin));
+    }
+    std::fs::write(&beyond, text).unwrap();
+    let values = exact_deviations(&model, beyond.to_str().unwrap(), &dir.path().join("b.csv"));
+    assert!(
+        values.iter().all(|d| (d - 0.1).abs() < 0.005),
+        "0.1 mm beyond the edge: {values:?}"
+    );
+    // One polynomial round the same points misses the true section by more than twice as much.
+    let single = dir.path().join("single.json");
+    let (fit, saved) = fit_ip(
+        scan.to_str().unwrap(),
+        &["--edges", "none", "--degree", "8"],
+        &single,
+    );
+    assert!(!fit.contains("sharp edge"), "{fit}");
+    assert_eq!(saved["model"]["kind"], "ip-profile");
+    let values = exact_deviations(&single, truth.to_str().unwrap(), &dir.path().join("s.csv"));
+    assert!(
+        largest(&values) > 2.0 * truth_worst,
+        "one polynomial: {} mm, the faces {truth_worst} mm",
+        largest(&values)
     );
 }
 

@@ -35,7 +35,11 @@ fn a_spurious_branch_is_a_warning_only_beside_the_data() {
         assert!(warnings(&printed).is_empty(), "blade {blade}:\n{printed}");
     }
     // A quartic on a NACA 2412 with a sharp trailing edge grows a branch 0.7 mm from the section: said.
-    let (printed, saved) = fit_ip(&config("profiles/naca2412-sharp-te-exact.csv"), &[], &model);
+    let (printed, saved) = fit_ip(
+        &config("profiles/naca2412-sharp-te-exact.csv"),
+        &["--edges", "none"],
+        &model,
+    );
     assert_eq!(
         saved["model"]["fit"]["branches_beside_data"], 1,
         "{printed}"

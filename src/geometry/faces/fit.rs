@@ -2,14 +2,17 @@
 
 use nalgebra::Vector2;
 
-use super::split::{
-    face_normals, find_corners, joint_of, orientation, perimeter_mm, split_at_corners,
-};
-use super::{meeting_point, FacedProfile, FacesError, Join};
+use super::split::{face_normals, find_corners, orientation, perimeter_mm, split_at_corners};
+use super::{meeting_point, trace_face, FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::implicit::Implicit;
+use crate::geometry::implicit::{Implicit, IpModel};
 use crate::geometry::sampling::{project_to_zero_set, Aabb};
 
+/// How many times a sharp edge's own point counts in the fits of the faces that meet there. The edge is where
+/// the faces cross, and where they cross at a small angle (a thin trailing edge's 8 deg) an error of the faces
+/// across their length moves it along the edge's bisector 14 times as far; held to the measured edge, both faces
+/// cross within the probe's noise of it. (Measured on NACA 0006 sections: see BENCHMARKS.md.)
+const EDGE_WEIGHT: usize = 20;
 /// The degrees a face's fit chooses from when none is given.
 pub const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
 /// A higher degree is chosen only when its held-out RMS is below this fraction of the lower one's: noise alone
@@ -58,6 +61,16 @@ pub fn fit_faces(
     for (j, face) in faces.iter().enumerate() {
         let face_points: Vec<Vector2<f64>> = face.indices.iter().map(|&i| points[i]).collect();
         let normals = face_normals(points, &face.indices, 1.0, perimeter);
+        // A sharp end's point, repeated so that the face passes through it: see [`EDGE_WEIGHT`].
+        let last = face_points.len() - 1;
+        let edges: Vec<(Vector2<f64>, Vector2<f64>)> =
+            [(face.start.sharp, 0), (face.end.sharp, last)]
+                .into_iter()
+                .filter(|(sharp, _)| *sharp)
+                .flat_map(|(_, k)| {
+                    std::iter::repeat_n((face_points[k], normals[k]), EDGE_WEIGHT - 1)
+                })
+                .collect();
         let fit = |degree: usize, every: usize, from: usize| {
             let (p, n): (Vec<_>, Vec<_>) = face_points
                 .iter()
@@ -65,6 +78,7 @@ pub fn fit_faces(
                 .skip(from)
                 .step_by(every)
                 .map(|(p, n)| (*p, *n))
+                .chain(edges.iter().copied())
                 .unzip();
             fit_ip(&p, &n, &FitOptions::new(degree, options.method))
                 .map_err(|source| FacesError::Fit { face: j, source })
@@ -84,7 +98,26 @@ pub fn fit_faces(
                 (choose_degree(&scores), scores)
             }
         };
-        fitted.push(fit(degree, 1, 0)?);
+        // The chosen degree first, then the others by their held-out RMS: the first whose curve runs along the
+        // face's points from end to end (a short, nearly straight face can leave a degree's curve crossing itself).
+        let mut order: Vec<usize> = vec![degree];
+        let mut others = scores.clone();
+        others.sort_by(|a, b| a.1.total_cmp(&b.1));
+        order.extend(others.iter().map(|(d, _)| *d).filter(|d| *d != degree));
+        let mut face_fit = Err(FacesError::Untraceable {
+            face: j,
+            from: face_points[0].into(),
+            to: face_points[last].into(),
+            problem: "no degree tried gives a curve along the face's points",
+        });
+        for degree in order {
+            let candidate = fit(degree, 1, 0)?;
+            if runs_along(&candidate.model, &face_points) {
+                face_fit = Ok(candidate);
+                break;
+            }
+        }
+        fitted.push(face_fit?);
         held_out.push(scores);
     }
     let n = faces.len();
@@ -92,8 +125,9 @@ pub fn fit_faces(
     for j in 0..n {
         let next = (j + 1) % n;
         let (before, after) = (&fitted[j].model, &fitted[next].model);
-        let join = if faces[j].sharp_end {
-            let apex = points[faces[next].indices[0]];
+        let end = faces[j].end;
+        let join = if end.sharp {
+            let apex = points[end.at];
             let point = meeting_point(before, after, &apex).ok_or(FacesError::NoMeeting {
                 before: j,
                 after: next,
@@ -104,8 +138,8 @@ pub fn fit_faces(
                 sharp: true,
             }
         } else {
-            let joint = points[joint_of(&faces).expect("a one-edge profile has a joint")];
-            let on = |f: &crate::geometry::implicit::IpModel<2>| {
+            let joint = points[end.at];
+            let on = |f: &IpModel<2>| {
                 project_to_zero_set(f, &joint, super::JOIN_SEARCH_MM).unwrap_or(joint)
             };
             Join {
@@ -127,6 +161,28 @@ pub fn fit_faces(
         model,
         domain,
     }))
+}
+
+/// Whether a face's fitted curve can be followed from its first point to its last within the points' box (grown
+/// by a tenth of its diagonal).
+fn runs_along(model: &IpModel<2>, face_points: &[Vector2<f64>]) -> bool {
+    let Some(bounds) = Aabb::of_points(face_points) else {
+        return false;
+    };
+    let margin = Vector2::repeat(0.1 * bounds.diagonal());
+    let limits = Aabb {
+        min: bounds.min - margin,
+        max: bounds.max + margin,
+    };
+    let length: f64 = face_points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    trace_face(
+        model,
+        &face_points[0],
+        &face_points[face_points.len() - 1],
+        2.0 * length,
+        &limits,
+    )
+    .is_ok()
 }
 
 /// The lowest degree whose held-out RMS no higher degree beats by more than noise does.

@@ -1,61 +1,193 @@
 use nalgebra::Vector2;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use zeroset_sim::naca::Naca4;
 
 use super::*;
 use crate::geometry::fit3l::FitMethod;
+use crate::geometry::normals::ordered_profile_normals;
 
-/// A NACA 4-digit section with a sharp trailing edge: `count` points round it with seeded noise of `sigma` mm
-/// along the normal, and the noise-free section densely (to 0.1 um) for the truth.
-pub(super) fn naca(
-    digits: &str,
-    chord: f64,
-    count: usize,
-    sigma: f64,
-    seed: u64,
-) -> Vec<Vector2<f64>> {
-    let foil = Naca4::from_digits(digits, chord, true).unwrap();
-    let clean: Vec<Vector2<f64>> = foil.points(count).into_iter().map(Vector2::from).collect();
+const AUTO: FacesFitOptions = FacesFitOptions {
+    degree: None,
+    method: FitMethod::Orthogonal,
+};
+
+fn foil(digits: &str, chord: f64) -> Naca4 {
+    Naca4::from_digits(digits, chord, true).unwrap()
+}
+
+/// 400 points round a NACA section with a sharp trailing edge, moved along the normal by seeded noise of 2 um.
+fn scanned(digits: &str, chord: f64, seed: u64) -> Vec<Vector2<f64>> {
+    let clean: Vec<Vector2<f64>> = foil(digits, chord)
+        .points(400)
+        .into_iter()
+        .map(Vector2::from)
+        .collect();
+    let normals = ordered_profile_normals(&clean);
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let noise = Normal::new(0.0, sigma).unwrap();
-    let n = clean.len();
-    (0..n)
-        .map(|i| {
-            let tangent = clean[(i + 1) % n] - clean[(i + n - 1) % n];
-            let normal = Vector2::new(tangent.y, -tangent.x).normalize();
-            clean[i] + normal * noise.sample(&mut rng)
-        })
+    let noise = Normal::new(0.0, 0.002).unwrap();
+    clean
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| p + n * noise.sample(&mut rng))
         .collect()
 }
 
-/// The true section densely: points 1e-5 of the parameter apart round it (0.1 um and less near the edges).
-pub(super) fn truth(digits: &str, chord: f64, count: usize) -> Vec<Vector2<f64>> {
-    let foil = Naca4::from_digits(digits, chord, true).unwrap();
-    foil.points(count).into_iter().map(Vector2::from).collect()
+/// The true section: 20 000 points, cosine-spaced, so that they crowd at both edges.
+fn truth(digits: &str, chord: f64) -> Vec<Vector2<f64>> {
+    foil(digits, chord)
+        .points(20_000)
+        .into_iter()
+        .map(Vector2::from)
+        .collect()
 }
 
 #[test]
-fn a_naca_2412_with_a_sharp_trailing_edge_is_followed_to_its_edge() {
-    let points = naca("2412", 100.0, 400, 0.002, 1);
-    let fitted = fit_faces(
-        &points,
-        &FacesFitOptions {
-            degree: None,
-            method: FitMethod::Orthogonal,
-        },
-    )
-    .unwrap()
-    .expect("a sharp trailing edge");
-    let (worst, at) = truth("2412", 100.0, 20_000)
-        .iter()
-        .map(|p| (fitted.model.foot(p).unwrap().distance.abs(), *p))
-        .fold(
-            (0.0, Vector2::zeros()),
-            |a, b| if b.0 > a.0 { b } else { a },
+fn naca_sections_with_sharp_trailing_edges_are_followed_within_5_um_to_their_edges() {
+    // Sections and draws the campaign of BENCHMARKS.md does not use (its draws are seeds 0 to 19). One
+    // polynomial of degree 8 misses the same sections by 20 um to 6.8 mm.
+    for (digits, chord, seed) in [
+        ("2412", 100.0, 101),
+        ("4412", 250.0, 102),
+        ("6412", 250.0, 103),
+        ("0006", 100.0, 104),
+    ] {
+        let fitted = fit_faces(&scanned(digits, chord, seed), &AUTO)
+            .unwrap()
+            .expect("a sharp trailing edge");
+        assert_eq!(fitted.faces.len(), 3, "NACA {digits}");
+        let (worst, at) = truth(digits, chord)
+            .iter()
+            .map(|p| (fitted.model.foot(p).unwrap().distance.abs(), *p))
+            .fold(
+                (0.0, Vector2::zeros()),
+                |w, d| if d.0 > w.0 { d } else { w },
+            );
+        assert!(
+            worst < 0.005,
+            "NACA {digits} at {chord} mm: the true section is {worst} mm from the model at {at:?}"
         );
-    eprintln!("at {at:?} joins {:?}", fitted.model.joins());
-    let edge = Vector2::from(fitted.model.joins()[1].point);
-    eprintln!("worst {worst} edge {edge:?} held out {:?}", fitted.held_out);
-    assert!(worst < 0.005, "{worst}");
+        let edges: Vec<&Join> = fitted.model.joins().iter().filter(|j| j.sharp).collect();
+        assert_eq!(edges.len(), 1);
+        // The edge is held to the measured edge point, which carries the probe's noise along the chord.
+        let apex = Vector2::from(edges[0].point);
+        assert!(
+            (apex - Vector2::new(chord, 0.0)).norm() < 0.010,
+            "NACA {digits} at {chord} mm: trailing edge at {apex:?}"
+        );
+    }
+}
+
+#[test]
+fn a_profile_without_a_sharp_edge_has_no_faces() {
+    let ellipse: Vec<Vector2<f64>> = (0..300)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / 300.0;
+            Vector2::new(40.0 * t.cos(), 6.0 * t.sin())
+        })
+        .collect();
+    assert!(fit_faces(&ellipse, &AUTO).unwrap().is_none());
+}
+
+/// Whether `p` is inside the closed polygon (crossing number).
+fn inside(polygon: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
+    let n = polygon.len();
+    let mut crossings = 0;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if x > p.x {
+                crossings += 1;
+            }
+        }
+    }
+    crossings % 2 == 1
+}
+
+#[test]
+fn exact_distances_to_a_faced_section_match_a_dense_independent_reference() {
+    // A thin section, where a point inside lies near both faces and beyond the edge a face's continuation lies
+    // nearer than the part.
+    let fitted = fit_faces(&scanned("0006", 100.0, 7), &AUTO)
+        .unwrap()
+        .expect("a sharp trailing edge");
+    let model = &fitted.model;
+    // The reference: every face's traced points with 40 more between each two, each projected onto its face
+    // (0.5 um apart), searched for the nearest by brute force through an index, then Newton on that face.
+    let mut dense = Vec::new();
+    let mut owner = Vec::new();
+    for (j, arc) in model.arcs.iter().enumerate() {
+        for piece in arc.points.windows(2) {
+            for k in 0..40 {
+                let between = piece[0] + (piece[1] - piece[0]) * (k as f64 / 40.0);
+                dense.push(project_to_zero_set(&model.faces[j], &between, 0.01).unwrap());
+                owner.push((j, false));
+            }
+        }
+        dense.push(*arc.points.last().unwrap());
+        owner.push((j, true));
+        owner[dense.len() - 1 - 40 * (arc.points.len() - 1)].1 = true;
+    }
+    let index = PointIndex::new(&dense);
+    let outline = model.outline();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let (mut checked, mut near_edge) = (0, 0);
+    while checked < 3000 {
+        // Within 5 mm of the section, a third of them round the trailing edge.
+        let p = if checked % 3 == 0 {
+            Vector2::new(rng.gen_range(95.0..105.0), rng.gen_range(-5.0..5.0))
+        } else {
+            Vector2::new(rng.gen_range(-5.0..105.0), rng.gen_range(-8.0..8.0))
+        };
+        let i = index.nearest(&p).unwrap();
+        let coarse = (p - dense[i]).norm();
+        if coarse > 5.0 {
+            continue;
+        }
+        // Newton from an interior point; at a face's end the end itself (Newton would run on past it).
+        let (face, end) = owner[i];
+        let refined = match end {
+            true => coarse,
+            false => lagrange_newton(&model.faces[face], &p, &dense[i])
+                .filter(|f| (f.point - dense[i]).norm() < 1e-3)
+                .map_or(coarse, |f| f.distance.abs().min(coarse)),
+        };
+        let foot = model.foot(&p).expect("a foot within 5 mm");
+        assert!(
+            (foot.distance.abs() - refined).abs() < 1e-6,
+            "{p:?}: {} mm, the reference {refined} mm",
+            foot.distance
+        );
+        if refined > 1e-4 {
+            let expected = if inside(&outline, &p) { -1.0 } else { 1.0 };
+            assert_eq!(foot.distance.signum(), expected, "{p:?}: {}", foot.distance);
+        }
+        if (p - Vector2::new(100.0, 0.0)).norm() < 5.0 {
+            near_edge += 1;
+        }
+        checked += 1;
+    }
+    assert!(near_edge > 500, "{near_edge}");
+}
+
+#[test]
+fn beyond_a_sharp_edge_the_edge_is_nearest_and_outside() {
+    let fitted = fit_faces(&scanned("2412", 100.0, 5), &AUTO)
+        .unwrap()
+        .expect("a sharp trailing edge");
+    let model = &fitted.model;
+    let apex = Vector2::from(model.joins().iter().find(|j| j.sharp).unwrap().point);
+    // Straight on from the edge and 60 deg off the chord: inside the edge's normal cone, the apex is the foot.
+    for angle in [0.0f64, 60.0, -60.0] {
+        let direction = Vector2::new(angle.to_radians().cos(), angle.to_radians().sin());
+        let p = apex + direction * 2.0;
+        let foot = model.foot(&p).unwrap();
+        assert!((foot.point - apex).norm() < 1e-9, "{angle} deg: {foot:?}");
+        assert!((foot.distance - 2.0).abs() < 1e-9, "{angle} deg: {foot:?}");
+    }
+    // Just inside the edge, on the chord: inside, nearer to a face than to the apex.
+    let p = apex - Vector2::new(0.5, 0.0);
+    let foot = model.foot(&p).unwrap();
+    assert!(foot.distance < 0.0 && foot.distance > -0.05, "{foot:?}");
 }
