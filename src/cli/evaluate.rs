@@ -13,18 +13,20 @@ use crate::analysis::section::{
 };
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
+use crate::geometry::faces::FacedProfile;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::ZeroSetSamples;
 use crate::geometry::section_fit::{fit_section, FitMethod, Form, Measured, SectionFit};
 use crate::geometry::section_parameters::{section_parameters, SectionParameters};
-use crate::model_file::{ModelFile, ReferenceModel};
+use crate::model_file::{FittedIp, ModelFile, ReferenceModel};
 use crate::points::{read_points, PointSet};
 
 /// Zero-set sampling for the exact distance's seeds, as `zeroset deviate` does.
 const CELLS: usize = 512;
 #[derive(Args)]
 pub struct EvaluateArgs {
-    /// The nominal: a profile model file written by `zeroset fit ip` from y,z points.
+    /// The nominal: a profile model file written by `zeroset fit ip` from y,z points (one polynomial, or faces
+    /// joined at sharp edges).
     #[arg(long)]
     model: PathBuf,
     /// The measured section: CSV with header y,z, in mm.
@@ -74,12 +76,7 @@ enum MethodArg {
 
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     let file = ModelFile::load(&args.model)?;
-    let ReferenceModel::Profile(model) = &file.model else {
-        bail!(
-            "{}: evaluate needs a profile model (fitted from y,z points); this one is 3-D",
-            args.model.display()
-        );
-    };
+    let nominal = Nominal::of(&file.model).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
     let PointSet::Profile(points) = read_points(&args.points)? else {
         bail!(
             "{}: evaluate needs a section's y,z points; this file has x,y,z",
@@ -87,8 +84,6 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         );
     };
     let (pivot, chord) = chord_of(&points);
-    let samples = ZeroSetSamples::new(&model.ip, &model.domain.scaled(2.0), CELLS);
-    let exact = ExactDistance::new(&model.ip, &samples);
     let (mode, mode_name) = match args.fit {
         FitArg::None => (BestFitMode::None, "no fit"),
         FitArg::Translation => (BestFitMode::Translation, "translations"),
@@ -115,20 +110,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         mode.fit_mode(),
         method,
         &limits,
-        |moved| {
-            exact
-                .feet_along_scan(moved)
-                .into_iter()
-                .map(|foot| {
-                    let foot = foot.ok()?;
-                    let (_, gradient) = model.ip.value_gradient(&foot.point);
-                    Some(Measured {
-                        distance_mm: foot.distance,
-                        normal: gradient.try_normalize(0.0)?,
-                    })
-                })
-                .collect()
-        },
+        |moved| nominal.measure(moved),
     )
     .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     println!(
@@ -143,27 +125,90 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
     print_fit(&fitted, &chord, &settings.limits());
     let measured = section_parameters(&points, args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
-    // The nominal outline: the model's zero set along the points' feet.
-    let nominal = points
-        .iter()
-        .map(|p| exact.foot(p, None).map(|foot| foot.point))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| {
-            anyhow!(
-                "{}: a point has no foot on the model: {e}",
-                args.model.display()
-            )
+    let nominal = nominal
+        .outline(&points)
+        .and_then(|outline| {
+            section_parameters(&outline, args.edge_distance).map_err(|e| e.to_string())
         })
-        .and_then(|feet| {
-            section_parameters(&nominal_outline(&model.ip, &feet), args.edge_distance)
-                .map_err(|e| anyhow!("{}: {e}", args.model.display()))
-        });
+        .map_err(|e| anyhow!("{}: {e}", args.model.display()));
     print_parameters(&measured, nominal, args.edge_distance);
     if let Some(out) = &args.out {
         write_deviations(out, &points, &fitted)?;
         println!("wrote {}", out.display());
     }
     Ok(())
+}
+
+/// The nominal a section is evaluated against: one polynomial round the profile (with its zero set sampled for the
+/// exact distance's seeds), or its faces.
+enum Nominal<'a> {
+    Profile {
+        model: &'a FittedIp<2>,
+        samples: ZeroSetSamples<2>,
+    },
+    Faces(FacedProfile),
+}
+
+impl<'a> Nominal<'a> {
+    fn of(model: &'a ReferenceModel) -> Result<Self, String> {
+        match model {
+            ReferenceModel::Profile(model) => Ok(Self::Profile {
+                model,
+                samples: ZeroSetSamples::new(&model.ip, &model.domain.scaled(2.0), CELLS),
+            }),
+            ReferenceModel::Faces(faced) => {
+                faced.profile().map(Self::Faces).map_err(|e| e.to_string())
+            }
+            _ => Err(
+                "evaluate needs a profile model (fitted from y,z points); this one is 3-D"
+                    .to_string(),
+            ),
+        }
+    }
+
+    /// The signed distance and outward normal of each point at its foot.
+    fn measure(&self, points: &[Vector2<f64>]) -> Vec<Option<Measured>> {
+        match self {
+            Self::Profile { model, samples } => ExactDistance::new(&model.ip, samples)
+                .feet_along_scan(points)
+                .into_iter()
+                .map(|foot| {
+                    let foot = foot.ok()?;
+                    let (_, gradient) = model.ip.value_gradient(&foot.point);
+                    Some(Measured {
+                        distance_mm: foot.distance,
+                        normal: gradient.try_normalize(0.0)?,
+                    })
+                })
+                .collect(),
+            Self::Faces(faces) => points
+                .iter()
+                .map(|p| {
+                    let foot = faces.foot(p)?;
+                    Some(Measured {
+                        distance_mm: foot.distance,
+                        normal: faces.outward_normal(p, &foot)?,
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// The nominal outline: a polynomial's zero set along the points' feet, or the faces traced from edge to edge.
+    fn outline(&self, points: &[Vector2<f64>]) -> Result<Vec<Vector2<f64>>, String> {
+        match self {
+            Self::Profile { model, samples } => {
+                let exact = ExactDistance::new(&model.ip, samples);
+                points
+                    .iter()
+                    .map(|p| exact.foot(p, None).map(|foot| foot.point))
+                    .collect::<Result<Vec<_>, _>>()
+                    .map(|feet| nominal_outline(&model.ip, &feet))
+                    .map_err(|e| format!("a point has no foot on the model: {e}"))
+            }
+            Self::Faces(faces) => Ok(faces.outline()),
+        }
+    }
 }
 
 fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>, limits: &BestFitLimits) {

@@ -1,13 +1,10 @@
 //! Fitting the master's points and measuring the other blades against the model, through the binary.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use nalgebra::Vector2;
-use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use zeroset_sim::naca::Naca4;
 
-use crate::support::{config, deviate, fit_ip, mean};
+use crate::support::{config, deviate, fit_ip, mean, naca_csv};
 
 /// The exact deviations of a point file, every point required to have one.
 fn exact_deviations(model: &std::path::Path, points: &str, out: &std::path::Path) -> Vec<f64> {
@@ -204,23 +201,6 @@ fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
         "an offset of 0.25 mm everywhere: {:?}",
         &values[..5]
     );
-}
-
-/// Points of a NACA section with a sharp trailing edge written as a y,z file: `count` round it, each moved along
-/// its normal by `offset` mm and by seeded Gaussian noise of `sigma` mm.
-fn naca_csv(path: &Path, foil: &Naca4, count: usize, offset: f64, sigma: f64, seed: u64) {
-    let points: Vec<Vector2<f64>> = foil.points(count).into_iter().map(Vector2::from).collect();
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let noise = Normal::new(0.0, sigma.max(f64::MIN_POSITIVE)).unwrap();
-    let n = points.len();
-    let mut text = String::from("y,z\n");
-    for i in 0..n {
-        let tangent = points[(i + 1) % n] - points[(i + n - 1) % n];
-        let normal = Vector2::new(tangent.y, -tangent.x).normalize();
-        let p = points[i] + normal * (offset + noise.sample(&mut rng));
-        text.push_str(&format!("{:.7},{:.7}\n", p.x, p.y));
-    }
-    std::fs::write(path, text).unwrap();
 }
 
 #[test]

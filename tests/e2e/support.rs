@@ -3,6 +3,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use nalgebra::Vector2;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use zeroset_sim::naca::Naca4;
+
 pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -114,4 +119,21 @@ pub fn fit_ip(points: &str, extra: &[&str], out: &Path) -> (String, serde_json::
     let saved =
         serde_json::from_str(&std::fs::read_to_string(out).expect("the model file")).expect("JSON");
     (printed, saved)
+}
+
+/// Points of a NACA section with a sharp trailing edge written as a y,z file: `count` round it, each moved along
+/// its normal by `offset` mm and by seeded Gaussian noise of `sigma` mm.
+pub fn naca_csv(path: &Path, foil: &Naca4, count: usize, offset: f64, sigma: f64, seed: u64) {
+    let points: Vec<Vector2<f64>> = foil.points(count).into_iter().map(Vector2::from).collect();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, sigma.max(f64::MIN_POSITIVE)).unwrap();
+    let n = points.len();
+    let mut text = String::from("y,z\n");
+    for i in 0..n {
+        let tangent = points[(i + 1) % n] - points[(i + n - 1) % n];
+        let normal = Vector2::new(tangent.y, -tangent.x).normalize();
+        let p = points[i] + normal * (offset + noise.sample(&mut rng));
+        text.push_str(&format!("{:.7},{:.7}\n", p.x, p.y));
+    }
+    std::fs::write(path, text).unwrap();
 }

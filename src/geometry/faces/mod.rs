@@ -249,6 +249,27 @@ impl FacedProfile {
         best
     }
 
+    /// The part's outward unit normal at `foot`, the foot of `p`: along the offset from the foot to `p`, or, for a
+    /// point on the part, the gradient of the face it lies on. `None` for a point on the part at a sharp edge,
+    /// where there is no one normal.
+    pub fn outward_normal(&self, p: &Vector2<f64>, foot: &Foot<2>) -> Option<Vector2<f64>> {
+        if foot.distance.abs() > 1e-9 {
+            return Some((p - foot.point) / foot.distance);
+        }
+        let (j, k) = self.locate(self.index.nearest(&foot.point)?);
+        let at_edge = match k {
+            0 => self.arcs[j].start_edge.is_some(),
+            k => k == self.arcs[j].points.len() - 1 && self.arcs[j].end_edge.is_some(),
+        };
+        if at_edge && (self.arcs[j].points[k] - foot.point).norm() < 1e-9 {
+            return None;
+        }
+        self.faces[j]
+            .value_gradient(&foot.point)
+            .1
+            .try_normalize(0.0)
+    }
+
     /// The side of `p` seen from point k of arc j: the edge's R-function join at a sharp end, else the face's own.
     fn side_at_vertex(&self, j: usize, k: usize, p: &Vector2<f64>) -> f64 {
         let arc = &self.arcs[j];
