@@ -7,14 +7,14 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::fsutil::write_atomically;
-use crate::geometry::faces::{FacedProfile, FacesError, Join};
-use crate::geometry::fit3l::FitStats;
+use crate::geometry::faces::{FacedProfile, FacesError, FittedFaces, Join};
+use crate::geometry::fit3l::{FitStats, Fitted};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::interp::{Profile, ProfileStack, StackError};
 use crate::geometry::sampling::Aabb;
 use crate::geometry::supershape::csg::Solid;
 use crate::geometry::supershape::distance::SolidDistance;
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector2};
 
 pub const FORMAT: &str = "zeroset-model";
 pub const VERSION: u32 = 1;
@@ -113,6 +113,16 @@ pub struct FittedIp<const N: usize> {
     pub fit: Option<FitStats>,
 }
 
+impl<const N: usize> From<Fitted<N>> for FittedIp<N> {
+    fn from(fitted: Fitted<N>) -> Self {
+        Self {
+            ip: fitted.model,
+            domain: fitted.domain,
+            fit: Some(fitted.stats),
+        }
+    }
+}
+
 impl<const N: usize> FittedIp<N> {
     /// What a model file must satisfy to be evaluated as it was saved: a positive, finite scale, a polynomial
     /// that is not identically zero, and a domain whose corners are finite and ordered.
@@ -149,6 +159,26 @@ pub struct FacedIp {
 }
 
 impl FacedIp {
+    /// A profile fitted face by face, with its distances to the `points` it was fitted to.
+    pub fn of(fitted: FittedFaces, points: &[Vector2<f64>]) -> Self {
+        let distances: Vec<f64> = points
+            .iter()
+            .map(|p| fitted.model.foot(p).map_or(f64::INFINITY, |f| f.distance))
+            .collect();
+        let stats = SolidFitStats {
+            points: distances.len(),
+            rms_distance_mm: (distances.iter().map(|d| d * d).sum::<f64>()
+                / distances.len().max(1) as f64)
+                .sqrt(),
+            max_distance_mm: distances.iter().fold(0.0, |m, d| m.max(d.abs())),
+        };
+        Self {
+            joins: fitted.model.joins().to_vec(),
+            faces: fitted.faces.into_iter().map(FittedIp::from).collect(),
+            fit: Some(stats),
+        }
+    }
+
     /// The box of every face's points, mm.
     pub fn domain(&self) -> Aabb<2> {
         let mut domain = self.faces[0].domain;

@@ -13,6 +13,7 @@ pub use self::file::ReferenceFileError;
 use super::edges::{find_sharp_edges, SharpEdge};
 use super::nominals::thin_to_nominals;
 pub use super::nominals::NominalPoint;
+use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions, FitStats, Fitted};
 use crate::geometry::interp::StackError;
 use crate::geometry::normals::ordered_profile_normals;
@@ -21,7 +22,7 @@ use crate::geometry::supershape::csg::{Node, Solid};
 use crate::geometry::supershape::distance::SolidDistance;
 use crate::geometry::supershape::prism::{fit_prism_section, PrismFitError};
 use crate::model_file::{
-    stack_of, FittedIp, ModelFile, ReferenceModel, SolidFitStats, StackProfile,
+    stack_of, FacedIp, FittedIp, ModelFile, ReferenceModel, SolidFitStats, StackProfile,
 };
 
 pub const FORMAT: &str = "zeroset-reference";
@@ -126,6 +127,10 @@ pub struct ReferenceProfile {
     /// its distance to the edge, not to the model (see `edges`).
     #[serde(default)]
     pub edges: Vec<SharpEdge>,
+    /// The profile fitted face by face between its sharp edges, where it has any (`geometry::faces`): its points
+    /// are measured against the faces, and its nominal parameters taken from them, instead of its polynomial.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub faces: Option<FacedIp>,
 }
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -203,9 +208,26 @@ pub fn teach(
         ),
     };
     let with_edges = matches!(model, ReferenceModel::Stack { .. });
+    let faces: Vec<Option<FacedIp>> = if with_edges {
+        std::thread::scope(|scope| {
+            let fits: Vec<_> = profiles
+                .iter()
+                .map(|profile| scope.spawn(|| profile_faces(profile)))
+                .collect();
+            fits.into_iter()
+                .map(|fit| {
+                    fit.join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                })
+                .collect()
+        })
+    } else {
+        vec![None; profiles.len()]
+    };
     let taught = profiles
         .iter()
-        .map(|p| ReferenceProfile {
+        .zip(faces)
+        .map(|(p, faces)| ReferenceProfile {
             name: p.name.clone(),
             x_mm: p.x_mm,
             nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
@@ -214,6 +236,7 @@ pub fn teach(
             } else {
                 Vec::new()
             },
+            faces,
         })
         .collect();
     Ok(Reference {
@@ -362,11 +385,7 @@ fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackPro
     }
     Ok(StackProfile {
         x: x_mm,
-        fitted: FittedIp {
-            ip: fitted.model,
-            domain: fitted.domain,
-            fit: Some(fitted.stats),
-        },
+        fitted: FittedIp::from(fitted),
     })
 }
 
@@ -387,6 +406,47 @@ fn profile_edges(profile: &MasterProfile) -> Vec<SharpEdge> {
         tracing::info!(profile = %profile.name, x_mm = profile.x_mm, apex_y_mm = edge.apex[0], apex_z_mm = edge.apex[1], turn_deg = edge.turn_rad.to_degrees(), "sharp edge");
     }
     edges
+}
+
+/// A master profile fitted face by face between its sharp edges (degrees chosen by held-out points); `None` when
+/// it has no sharp edge, or when its faces cannot be fitted, which is said: it is then measured against its
+/// polynomial, with the edge's wedge.
+fn profile_faces(profile: &MasterProfile) -> Option<FacedIp> {
+    let points: Vec<Vector2<f64>> = profile
+        .points
+        .iter()
+        .map(|p| Vector2::new(p.y, p.z))
+        .collect();
+    let options = FacesFitOptions {
+        degree: None,
+        method: FitMethod::Orthogonal,
+    };
+    match fit_faces(&points, &options) {
+        Ok(fitted) => fitted.map(|fitted| {
+            let faced = FacedIp::of(fitted, &points);
+            if let Some(fit) = &faced.fit {
+                tracing::info!(
+                    profile = %profile.name,
+                    x_mm = profile.x_mm,
+                    faces = faced.faces.len(),
+                    rms_mm = fit.rms_distance_mm,
+                    max_mm = fit.max_distance_mm,
+                    "fitted face by face between its sharp edges"
+                );
+            }
+            faced
+        }),
+        Err(problem) => {
+            tracing::warn!(
+                profile = %profile.name,
+                x_mm = profile.x_mm,
+                %problem,
+                "the profile's faces could not be fitted between its sharp edges: it is measured against its \
+                 polynomial and each edge's wedge"
+            );
+            None
+        }
+    }
 }
 
 /// Whether `a` describes a closer fit than `b`: every point placed, then a smaller RMS. A sliver beside the data

@@ -13,9 +13,7 @@ use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitOptions, Fitted};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
-use crate::model_file::{
-    FacedIp, FittedIp, ModelFile, ReferenceModel, SolidFitStats, StackProfile,
-};
+use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
 use crate::points::{read_point_file, PointFile, PointSet};
 
 #[derive(Args)]
@@ -108,7 +106,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
                     let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
                     print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
                     (
-                        ReferenceModel::Profile(into_file(fitted.clone())),
+                        ReferenceModel::Profile(FittedIp::from(fitted.clone())),
                         fitted.method,
                     )
                 }
@@ -118,7 +116,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
             print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
             (
-                ReferenceModel::Profile(into_file(fitted.clone())),
+                ReferenceModel::Profile(FittedIp::from(fitted.clone())),
                 fitted.method,
             )
         }
@@ -135,7 +133,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             print_fit(&args.points, "surface", &fitted, &points, args.tolerance);
             warn_if_profiles(&points, args.plane_tolerance);
             (
-                ReferenceModel::Surface(into_file(fitted.clone())),
+                ReferenceModel::Surface(FittedIp::from(fitted.clone())),
                 fitted.method,
             )
         }
@@ -218,16 +216,8 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
             face.stats.max_distance_mm
         );
     }
-    let distances: Vec<f64> = points
-        .iter()
-        .map(|p| fitted.model.foot(p).map_or(f64::INFINITY, |f| f.distance))
-        .collect();
-    let stats = SolidFitStats {
-        points: distances.len(),
-        rms_distance_mm: (distances.iter().map(|d| d * d).sum::<f64>() / distances.len() as f64)
-            .sqrt(),
-        max_distance_mm: distances.iter().fold(0.0, |m, d| m.max(d.abs())),
-    };
+    let faced = FacedIp::of(fitted, points);
+    let stats = faced.fit.expect("a profile of faces' statistics");
     println!(
         "  distance of the fitted points to the joined faces: RMS {:.4} mm, max {:.4} mm",
         stats.rms_distance_mm, stats.max_distance_mm
@@ -242,19 +232,7 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
             );
         }
     }
-    Ok(Some(FacedIp {
-        faces: fitted.faces.into_iter().map(into_file).collect(),
-        joins: fitted.model.joins().to_vec(),
-        fit: Some(stats),
-    }))
-}
-
-fn into_file<const N: usize>(fitted: Fitted<N>) -> FittedIp<N> {
-    FittedIp {
-        ip: fitted.model,
-        domain: fitted.domain,
-        fit: Some(fitted.stats),
-    }
+    Ok(Some(faced))
 }
 
 fn fit_profile(
@@ -330,7 +308,7 @@ fn fit_stack(
         );
         profiles.push(StackProfile {
             x,
-            fitted: into_file(fitted),
+            fitted: FittedIp::from(fitted),
         });
     }
     Ok(profiles)
