@@ -83,12 +83,13 @@ pub fn assert_parameters_read_the_injected_errors(
             let chord_kept = (made.chord_scale - 1.0).abs() < 1e-12;
             let edge = |nominal: f64| chord_kept.then_some(nominal * (made.thickness_scale - 1.0));
             // Measured on one run of blades alike: thickness within 4.2 um, camber 3.7 um, chord angle 2.3
-            // millidegrees, pitch 0.012 %, trailing-edge thickness 4.0 um. The chord reads within 13 um on blades
-            // of the shape errors (31 um before the sharp trailing edge's roll was compensated from its circle),
-            // but up to 25 um on propeller.toml's blade B, whose sections are turned by its pitch error: what is
-            // left is the nominal nose, which the degree-8 model swells or shrinks by about ten microns, and on B
-            // a cause not yet found (BENCHMARKS.md, "The chord"). The leading-edge thickness (24 um) hangs on the
-            // same nose. Both are held to 50 and 30 um until the model follows the nose (issue 15).
+            // millidegrees, pitch 0.012 %, trailing-edge thickness 4.0 um. The chord reads within 7.3 um on blades
+            // of the shape errors since the nominal is the master's faces (13 um against the degree-8 polynomial's
+            // nose, 31 um before the sharp trailing edge's roll was compensated from its circle), but up to 25 um
+            // on propeller.toml's blade B, whose sections are turned by its pitch error, for a cause not yet found
+            // (BENCHMARKS.md, "The chord"). The leading-edge thickness reads within 24 um against the faces' nose
+            // as against the polynomial's, so its error is not the nominal's; its cause is not yet found either.
+            // Both are held to 50 and 30 um until they are.
             let checks = [
                 (
                     "max thickness",
