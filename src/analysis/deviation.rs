@@ -137,7 +137,7 @@ impl ProfileGauge {
             .get_or_init(|| match &self.model {
                 GaugeModel::Ip {
                     faces: Some(faces), ..
-                } => section_parameters(&faces.outline(), section::EDGE_DISTANCE_MM)
+                } => section_parameters(&section::faces_outline(faces), section::EDGE_DISTANCE_MM)
                     .map_err(|e| format!("its nominal: {e}")),
                 GaugeModel::Ip {
                     model,
@@ -315,30 +315,23 @@ mod tests {
     #[test]
     fn a_profile_with_a_sharp_edge_is_taught_and_measured_face_by_face() {
         use crate::analysis::reference::{teach, MasterProfile, ReferenceSettings};
+        use crate::geometry::fit3l::tests::with_probe_noise;
         use crate::geometry::fit3l::FitMethod;
         use crate::geometry::normals::ordered_profile_normals;
         use nalgebra::Vector3;
-        use rand::SeedableRng;
-        use rand_distr::{Distribution, Normal};
         use zeroset_sim::naca::Naca4;
 
         let foil = Naca4::from_digits("2412", 100.0, true).unwrap();
         let section: Vec<Vector2<f64>> = foil.points(400).into_iter().map(Vector2::from).collect();
         let normals = ordered_profile_normals(&section);
-        let mut rng = rand::rngs::StdRng::seed_from_u64(9);
-        let noise = Normal::new(0.0, 0.002).unwrap();
         let master: Vec<MasterProfile> = [100.0, 200.0]
             .iter()
             .map(|&x| MasterProfile {
                 name: format!("x{x}"),
                 x_mm: x,
-                points: section
+                points: with_probe_noise(&section, 0.002, x as u64)
                     .iter()
-                    .zip(&normals)
-                    .map(|(p, n)| {
-                        let q = p + n * noise.sample(&mut rng);
-                        Point3::new(x, q.x, q.y)
-                    })
+                    .map(|q| Point3::new(x, q.x, q.y))
                     .collect(),
                 normals: normals
                     .iter()

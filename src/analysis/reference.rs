@@ -208,11 +208,14 @@ pub fn teach(
         ),
     };
     let with_edges = matches!(model, ReferenceModel::Stack { .. });
-    let faces: Vec<Option<FacedIp>> = if with_edges {
+    let faces: Vec<Option<FacedIp>> = if let ReferenceModel::Stack { profiles: fitted } = &model {
         std::thread::scope(|scope| {
             let fits: Vec<_> = profiles
                 .iter()
-                .map(|profile| scope.spawn(|| profile_faces(profile)))
+                .zip(fitted)
+                .map(|(profile, fitted)| {
+                    scope.spawn(|| profile_faces(profile, fitted.fitted.fit.as_ref()))
+                })
                 .collect();
             fits.into_iter()
                 .map(|fit| {
@@ -409,9 +412,9 @@ fn profile_edges(profile: &MasterProfile) -> Vec<SharpEdge> {
 }
 
 /// A master profile fitted face by face between its sharp edges (degrees chosen by held-out points); `None` when
-/// it has no sharp edge, or when its faces cannot be fitted, which is said: it is then measured against its
-/// polynomial, with the edge's wedge.
-fn profile_faces(profile: &MasterProfile) -> Option<FacedIp> {
+/// it has no sharp edge, or when its faces cannot be fitted or fit its points worse than its polynomial does
+/// (`polynomial`, RMS), which is said: it is then measured against its polynomial, with the edge's wedge.
+fn profile_faces(profile: &MasterProfile, polynomial: Option<&FitStats>) -> Option<FacedIp> {
     let points: Vec<Vector2<f64>> = profile
         .points
         .iter()
@@ -422,19 +425,32 @@ fn profile_faces(profile: &MasterProfile) -> Option<FacedIp> {
         method: FitMethod::Orthogonal,
     };
     match fit_faces(&points, &options) {
-        Ok(fitted) => fitted.map(|fitted| {
+        Ok(fitted) => fitted.and_then(|fitted| {
+            let gaps_mm = fitted.joint_gaps_mm.clone();
             let faced = FacedIp::of(fitted, &points);
-            if let Some(fit) = &faced.fit {
-                tracing::info!(
+            let fit = faced.fit.as_ref()?;
+            let polynomial_rms = polynomial.map_or(f64::INFINITY, |p| p.rms_distance_mm);
+            if fit.rms_distance_mm > FACES_RMS_ALLOWANCE * polynomial_rms {
+                tracing::warn!(
                     profile = %profile.name,
                     x_mm = profile.x_mm,
-                    faces = faced.faces.len(),
-                    rms_mm = fit.rms_distance_mm,
-                    max_mm = fit.max_distance_mm,
-                    "fitted face by face between its sharp edges"
+                    faces_rms_mm = fit.rms_distance_mm,
+                    polynomial_rms_mm = polynomial_rms,
+                    "the profile's faces fit its points worse than its polynomial: it is measured against the \
+                     polynomial and each edge's wedge"
                 );
+                return None;
             }
-            faced
+            tracing::info!(
+                profile = %profile.name,
+                x_mm = profile.x_mm,
+                faces = faced.faces.len(),
+                rms_mm = fit.rms_distance_mm,
+                max_mm = fit.max_distance_mm,
+                joint_gaps_mm = ?gaps_mm,
+                "fitted face by face between its sharp edges"
+            );
+            Some(faced)
         }),
         Err(problem) => {
             tracing::warn!(
@@ -448,6 +464,10 @@ fn profile_faces(profile: &MasterProfile) -> Option<FacedIp> {
         }
     }
 }
+
+/// The faces stand for a master profile unless their RMS distance to its points exceeds its polynomial's by more
+/// than this factor (both follow 2 um of probe noise; faces that round a corner that is not there would not).
+const FACES_RMS_ALLOWANCE: f64 = 1.25;
 
 /// Whether `a` describes a closer fit than `b`: every point placed, then a smaller RMS. A sliver beside the data
 /// is not ruled out: on profile r200 of the simulated propeller the only fits without one miss the trailing edge by

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::deviation::ProfileGauge;
 use super::edges::{sharpen, SharpEdge};
 use super::tolerances::{AppliedTolerance, Parameter, ParameterVerdict};
+use crate::geometry::faces::FacedProfile;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::project_to_zero_set;
 use crate::geometry::section_fit::{fit_section, FitLimits, FitMethod, FitMode, Form, Measured};
@@ -347,6 +348,12 @@ pub(crate) fn nominal_parameters(
         EDGE_DISTANCE_MM,
     )
     .map_err(|e| format!("its nominal: {e}"))
+}
+
+/// The outline of a profile of faces for its parameters: the traced faces, thinned where they are straight (the
+/// chord's farthest pair looks at every pair of the outline's points).
+pub(crate) fn faces_outline(faces: &FacedProfile) -> Vec<Vector2<f64>> {
+    simplify_closed(&faces.outline(), OUTLINE_TOLERANCE_MM)
 }
 
 /// One parameter of a section, nominal and measured (in the unit its name gives).

@@ -9,7 +9,8 @@ use clap::{Args, ValueEnum};
 use nalgebra::Vector2;
 
 use crate::analysis::section::{
-    chord_of, nominal_outline, BestFitLimits, BestFitMode, BestFitSettings, EDGE_DISTANCE_MM,
+    chord_of, faces_outline, nominal_outline, BestFitLimits, BestFitMode, BestFitSettings,
+    EDGE_DISTANCE_MM,
 };
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
@@ -206,7 +207,7 @@ impl<'a> Nominal<'a> {
                     .map(|feet| nominal_outline(&model.ip, &feet))
                     .map_err(|e| format!("a point has no foot on the model: {e}"))
             }
-            Self::Faces(faces) => Ok(faces.outline()),
+            Self::Faces(faces) => Ok(faces_outline(faces)),
         }
     }
 }

@@ -178,8 +178,12 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
         degree: args.degree,
         method: args.method.into(),
     };
-    let Some(fitted) =
-        fit_faces(points, &options).map_err(|e| anyhow!("{}: {e}", args.points.display()))?
+    let Some(fitted) = fit_faces(points, &options).map_err(|e| {
+        anyhow!(
+            "{}: {e}; check the points there, or fit one polynomial round the whole profile with --edges none",
+            args.points.display()
+        )
+    })?
     else {
         return Ok(None);
     };
@@ -198,7 +202,12 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
         edges.join(", "),
         fitted.faces.len()
     );
-    for (j, (face, held_out)) in fitted.faces.iter().zip(&fitted.held_out).enumerate() {
+    let faces = fitted
+        .faces
+        .iter()
+        .zip(&fitted.held_out)
+        .zip(&fitted.face_points);
+    for (j, ((face, held_out), points)) in faces.enumerate() {
         let chosen = if held_out.is_empty() {
             "given".to_string()
         } else {
@@ -211,9 +220,20 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
         println!(
             "  face {j}: degree {} ({chosen}), {} points, RMS {:.4} mm, max {:.4} mm",
             face.model.degree(),
-            face.stats.points,
+            points,
             face.stats.rms_distance_mm,
             face.stats.max_distance_mm
+        );
+    }
+    if !fitted.joint_gaps_mm.is_empty() {
+        let gaps: Vec<String> = fitted
+            .joint_gaps_mm
+            .iter()
+            .map(|g| format!("{:.2} um", g * 1000.0))
+            .collect();
+        println!(
+            "  at the smooth joints the faces' curves pass {} apart (the model's step there)",
+            gaps.join(", ")
         );
     }
     let faced = FacedIp::of(fitted, points);

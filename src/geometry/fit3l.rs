@@ -651,4 +651,4 @@ fn measure<const N: usize>(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -20,6 +20,19 @@ fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
         .collect()
 }
 
+/// What `zeroset evaluate --model MODEL --points POINTS` with the `extra` arguments printed.
+fn evaluate(model: &Path, points: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "evaluate",
+        "--model",
+        model.to_str().unwrap(),
+        "--points",
+        points.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    zeroset_ok(&args)
+}
+
 /// The master blade's profile 3 fitted into `dir`/a.json, and its own points 0.4 mm lower and 0.05 mm to +y (what
 /// a blade shifted on the hub would measure) in `dir`/moved.csv: the model, the moved section, the master's text.
 fn master_and_moved(dir: &Path) -> (PathBuf, PathBuf, String) {
@@ -45,17 +58,11 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
     let mut zones = Vec::new();
     for method in ["l2", "minzone"] {
         let out = dir.path().join(format!("{method}.csv"));
-        let printed = zeroset_ok(&[
-            "evaluate",
-            "--model",
-            model.to_str().unwrap(),
-            "--points",
-            section.to_str().unwrap(),
-            "--method",
-            method,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let printed = evaluate(
+            &model,
+            &section,
+            &["--method", method, "--out", out.to_str().unwrap()],
+        );
         let chord = numbers_after(&printed, "chord direction (y, z)", 2);
         let shift = numbers_after(&printed, "the section lies", 2);
         let (dn, dchord) = (shift[0], shift[1]);
@@ -114,13 +121,7 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
         (&scaled, 1.01, 0.0),
         (&turned, 1.0, 0.1),
     ] {
-        let printed = zeroset_ok(&[
-            "evaluate",
-            "--model",
-            model.to_str().unwrap(),
-            "--points",
-            points.to_str().unwrap(),
-        ]);
+        let printed = evaluate(&model, points, &[]);
         let chord = numbers_after(&printed, "chord (mm)", 3);
         let thickness = numbers_after(&printed, "max thickness, inscribed (mm)", 3);
         assert!(
@@ -157,21 +158,19 @@ fn a_section_moved_off_its_nominal_reads_back_as_the_motion_and_its_noise() {
 fn a_fit_held_within_a_limit_stops_there_says_so_and_keeps_the_rest_in_the_form() {
     let dir = tempfile::tempdir().unwrap();
     let (model, section, _) = master_and_moved(dir.path());
-    let (model, section) = (model.to_str().unwrap(), section.to_str().unwrap());
     for method in ["l2", "minzone"] {
-        let printed = zeroset_ok(&[
-            "evaluate",
-            "--model",
-            model,
-            "--points",
-            section,
-            "--method",
-            method,
-            "--max-dn-mm",
-            "0.25",
-            "--max-rotation-deg",
-            "0.5",
-        ]);
+        let printed = evaluate(
+            &model,
+            &section,
+            &[
+                "--method",
+                method,
+                "--max-dn-mm",
+                "0.25",
+                "--max-rotation-deg",
+                "0.5",
+            ],
+        );
         // Where the motion puts the section along its thickness direction (the chord turned +90 deg): farther off
         // than 0.25 mm, so the fit is held there.
         let chord = numbers_after(&printed, "chord direction (y, z)", 2);
@@ -199,9 +198,9 @@ fn a_fit_held_within_a_limit_stops_there_says_so_and_keeps_the_rest_in_the_form(
     let refused = zeroset(&[
         "evaluate",
         "--model",
-        model,
+        model.to_str().unwrap(),
         "--points",
-        section,
+        section.to_str().unwrap(),
         "--fit",
         "translation",
         "--max-rotation-deg",
@@ -244,13 +243,7 @@ fn a_section_with_a_sharp_edge_is_evaluated_against_its_faces() {
     }
     let section = dir.path().join("moved.csv");
     std::fs::write(&section, moved).unwrap();
-    let printed = zeroset_ok(&[
-        "evaluate",
-        "--model",
-        model.to_str().unwrap(),
-        "--points",
-        section.to_str().unwrap(),
-    ]);
+    let printed = evaluate(&model, &section, &[]);
     let shift = numbers_after(&printed, "the section lies", 2);
     let chord = numbers_after(&printed, "chord direction (y, z)", 2);
     let (dn, dchord) = (shift[0], shift[1]);

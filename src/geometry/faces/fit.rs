@@ -2,7 +2,7 @@
 
 use nalgebra::Vector2;
 
-use super::split::{face_normals, find_corners, orientation, perimeter_mm, split_at_corners};
+use super::split::{face_normals, find_corners, orientation, perimeter, split_at_corners};
 use super::{meeting_point, trace_face, FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
 use crate::geometry::implicit::{Implicit, IpModel};
@@ -14,9 +14,9 @@ use crate::geometry::sampling::{project_to_zero_set, Aabb};
 /// cross within the probe's noise of it. (Measured on NACA 0006 sections: see BENCHMARKS.md.)
 const EDGE_WEIGHT: usize = 20;
 /// The degrees a face's fit chooses from when none is given.
-pub const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
-/// A higher degree is chosen only when its held-out RMS is below this fraction of the lower one's: noise alone
-/// moves a held-out RMS by a few percent.
+const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
+/// A higher degree replaces the one chosen so far only when its held-out RMS is below this fraction of that one's:
+/// noise alone moves a held-out RMS by a few percent.
 const HIGHER_DEGREE_GAIN: f64 = 0.9;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,9 +32,12 @@ pub struct FittedFaces {
     pub faces: Vec<Fitted<2>>,
     /// For each face, the held-out RMS distance (mm) of each candidate degree tried, when the degree was chosen.
     pub held_out: Vec<Vec<(usize, f64)>>,
+    /// How many of the profile's points each face was fitted to (its fit's statistics count a sharp edge's point
+    /// as often as it weighs).
+    pub face_points: Vec<usize>,
+    /// At each smooth joint, how far apart the two faces' curves pass the joint, mm: the step the model has there.
+    pub joint_gaps_mm: Vec<f64>,
     pub model: FacedProfile,
-    /// The box of the fitted points, mm.
-    pub domain: Aabb<2>,
 }
 
 /// Fits a closed profile whose points run along it face by face, split at its sharp edges. `Ok(None)` when it
@@ -55,30 +58,31 @@ pub fn fit_faces(
         return Ok(None);
     }
     let faces = split_at_corners(points, &corners);
-    let perimeter = perimeter_mm(points);
+    let perimeter = perimeter(points);
     let mut fitted = Vec::with_capacity(faces.len());
     let mut held_out = Vec::with_capacity(faces.len());
+    let mut face_points_count = Vec::with_capacity(faces.len());
     for (j, face) in faces.iter().enumerate() {
         let face_points: Vec<Vector2<f64>> = face.indices.iter().map(|&i| points[i]).collect();
-        let normals = face_normals(points, &face.indices, 1.0, perimeter);
-        // A sharp end's point, repeated so that the face passes through it: see [`EDGE_WEIGHT`].
+        let normals = face_normals(points, &face.indices, perimeter);
         let last = face_points.len() - 1;
-        let edges: Vec<(Vector2<f64>, Vector2<f64>)> =
-            [(face.start.sharp, 0), (face.end.sharp, last)]
-                .into_iter()
-                .filter(|(sharp, _)| *sharp)
-                .flat_map(|(_, k)| {
-                    std::iter::repeat_n((face_points[k], normals[k]), EDGE_WEIGHT - 1)
-                })
-                .collect();
-        let fit = |degree: usize, every: usize, from: usize| {
+        let sharp_ends: Vec<usize> = [(face.start.sharp, 0), (face.end.sharp, last)]
+            .into_iter()
+            .filter_map(|(sharp, k)| sharp.then_some(k))
+            .collect();
+        // Every `every`-th point, and each sharp end's point repeated so that the face passes through it (see
+        // [`EDGE_WEIGHT`]; as much as among all the points when fitted to every other one).
+        let fit = |degree: usize, every: usize| {
+            let repeats = (EDGE_WEIGHT / every).saturating_sub(1);
+            let edges = sharp_ends
+                .iter()
+                .flat_map(|&k| std::iter::repeat_n((face_points[k], normals[k]), repeats));
             let (p, n): (Vec<_>, Vec<_>) = face_points
                 .iter()
                 .zip(&normals)
-                .skip(from)
                 .step_by(every)
                 .map(|(p, n)| (*p, *n))
-                .chain(edges.iter().copied())
+                .chain(edges)
                 .unzip();
             fit_ip(&p, &n, &FitOptions::new(degree, options.method))
                 .map_err(|source| FacesError::Fit { face: j, source })
@@ -87,11 +91,14 @@ pub fn fit_faces(
             Some(degree) => (degree, Vec::new()),
             None => {
                 let mut scores = Vec::new();
+                // Fitted to every other point, judged by the others (a sharp end's point is fitted, not judged).
+                let judged: Vec<Vector2<f64>> = (1..face_points.len())
+                    .step_by(2)
+                    .filter(|k| !sharp_ends.contains(k))
+                    .map(|k| face_points[k])
+                    .collect();
                 for degree in CANDIDATE_DEGREES {
-                    // Fitted to every other point, judged by the others.
-                    if let Ok(trained) = fit(degree, 2, 0) {
-                        let judged: Vec<Vector2<f64>> =
-                            face_points.iter().skip(1).step_by(2).copied().collect();
+                    if let Ok(trained) = fit(degree, 2) {
                         scores.push((degree, rms_distance(&trained.model, &judged)));
                     }
                 }
@@ -111,17 +118,22 @@ pub fn fit_faces(
             problem: "no degree tried gives a curve along the face's points",
         });
         for degree in order {
-            let candidate = fit(degree, 1, 0)?;
-            if runs_along(&candidate.model, &face_points) {
-                face_fit = Ok(candidate);
-                break;
+            match fit(degree, 1) {
+                Ok(candidate) if runs_along(&candidate.model, &face_points) => {
+                    face_fit = Ok(candidate);
+                    break;
+                }
+                Ok(_) => {}
+                Err(problem) => face_fit = Err(problem),
             }
         }
         fitted.push(face_fit?);
         held_out.push(scores);
+        face_points_count.push(face_points.len());
     }
     let n = faces.len();
     let mut joins = Vec::with_capacity(n);
+    let mut joint_gaps_mm = Vec::new();
     for j in 0..n {
         let next = (j + 1) % n;
         let (before, after) = (&fitted[j].model, &fitted[next].model);
@@ -142,6 +154,7 @@ pub fn fit_faces(
             let on = |f: &IpModel<2>| {
                 project_to_zero_set(f, &joint, super::JOIN_SEARCH_MM).unwrap_or(joint)
             };
+            joint_gaps_mm.push((on(before) - on(after)).norm());
             Join {
                 point: ((on(before) + on(after)) / 2.0).into(),
                 sharp: false,
@@ -158,8 +171,9 @@ pub fn fit_faces(
     Ok(Some(FittedFaces {
         faces: fitted,
         held_out,
+        face_points: face_points_count,
+        joint_gaps_mm,
         model,
-        domain,
     }))
 }
 
@@ -185,7 +199,8 @@ fn runs_along(model: &IpModel<2>, face_points: &[Vector2<f64>]) -> bool {
     .is_ok()
 }
 
-/// The lowest degree whose held-out RMS no higher degree beats by more than noise does.
+/// The degree by held-out RMS: from the lowest up, each higher degree replaces the one chosen so far only if it
+/// beats it by more than noise does ([`HIGHER_DEGREE_GAIN`]).
 fn choose_degree(scores: &[(usize, f64)]) -> usize {
     let mut chosen = scores
         .first()

@@ -14,7 +14,9 @@
 //! (half a piece's length and twice its sag) that proves no other piece lies nearer.
 
 mod fit;
-pub(crate) mod split;
+mod split;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
@@ -24,16 +26,17 @@ use super::implicit::{Implicit, IpModel};
 use super::nearest::PointIndex;
 use super::sampling::{project_to_zero_set, Aabb};
 
-pub use fit::{fit_faces, FacesFitOptions, FittedFaces, CANDIDATE_DEGREES};
+pub use fit::{fit_faces, FacesFitOptions, FittedFaces};
 
 /// Spacing of the traced faces' points, mm: short enough that a piece's sag is nanometres on a nose of 0.4 mm
 /// radius (0.02^2 / 8 / 0.4 = 0.1 um), and the bound that proves a foot stays tight.
 const TRACE_STEP_MM: f64 = 0.02;
 /// A traced face may run this many times the perimeter of the data's box before it is given up as lost.
 const TRACE_LENGTH_FACTOR: f64 = 2.0;
-/// Newton's iterations to find where two faces meet, and the step below which they have met, mm.
+/// Newton's iterations to find where two faces meet.
 const JOIN_ITERATIONS: usize = 50;
-const JOIN_TOLERANCE_MM: f64 = 1e-12;
+/// Newton's step below which two faces have met, relative to the coordinates' size (rounding, not a length).
+const JOIN_TOLERANCE: f64 = 1e-12;
 /// How far the faces' meeting point may lie from the edge found in the points, mm (a few scan steps).
 const JOIN_SEARCH_MM: f64 = 2.0;
 
@@ -122,6 +125,8 @@ pub struct FacedProfile {
     starts: Vec<usize>,
     /// No point of an arc piece lies nearer to a point than the nearer of the piece's ends less this, mm.
     reach: f64,
+    /// Feet given without proof: Newton failed on a piece that could hold a nearer point.
+    unproved: AtomicUsize,
 }
 
 impl FacedProfile {
@@ -193,11 +198,8 @@ impl FacedProfile {
             arcs,
             starts,
             reach: reach + 1e-9,
+            unproved: AtomicUsize::new(0),
         })
-    }
-
-    pub fn faces(&self) -> &[IpModel<2>] {
-        &self.faces
     }
 
     pub fn joins(&self) -> &[Join] {
@@ -218,11 +220,20 @@ impl FacedProfile {
         (j, entry - self.starts[j])
     }
 
+    /// How many feet so far were given without proof (see [`Self::foot`]).
+    pub fn unproved(&self) -> usize {
+        self.unproved.load(Ordering::Relaxed)
+    }
+
     /// The nearest point of the part to `p` and the signed distance to it (mm, positive outside), proved nearest:
-    /// every piece of the traced faces not examined lies farther than it.
+    /// every piece of the traced faces not examined lies farther than it, and on every piece examined Newton found
+    /// the nearest point or the piece's ends are. Where Newton failed on a piece that could hold a nearer point, the
+    /// foot is still given (the piece's ends bound it to within half a piece) and counted in [`Self::unproved`].
     pub fn foot(&self, p: &Vector2<f64>) -> Option<Foot<2>> {
         let mut best: Option<Foot<2>> = None;
         let mut examined: Vec<(usize, usize)> = Vec::new();
+        // The nearest end of a piece where Newton failed, mm.
+        let mut failed_at = f64::INFINITY;
         for entry in self.index.nearest_iter(p) {
             let (j, k) = self.locate(entry);
             let arc = &self.arcs[j];
@@ -241,10 +252,22 @@ impl FacedProfile {
                     continue;
                 }
                 examined.push((j, piece));
-                if let Some(foot) = self.foot_on_piece(j, piece, p) {
-                    keep_nearer(&mut best, foot);
+                match self.foot_on_piece(j, piece, p) {
+                    OnPiece::Foot(foot) => keep_nearer(&mut best, foot),
+                    OnPiece::Elsewhere => {}
+                    OnPiece::Failed => {
+                        let ends = &arc.points[piece..piece + 2];
+                        let nearer = ends
+                            .iter()
+                            .map(|e| (p - e).norm())
+                            .fold(f64::INFINITY, f64::min);
+                        failed_at = failed_at.min(nearer);
+                    }
                 }
             }
+        }
+        if best.is_some_and(|b| failed_at - self.reach < b.distance.abs()) {
+            self.unproved.fetch_add(1, Ordering::Relaxed);
         }
         best
     }
@@ -292,28 +315,45 @@ impl FacedProfile {
         }
     }
 
-    /// The foot of `p` on the piece of arc j from its point k to k + 1, by Newton from the chord's nearest point;
-    /// `None` when Newton leaves the piece's neighbourhood or runs past the arc's ends (onto the face's
-    /// continuation beyond a join, which is not the part).
-    fn foot_on_piece(&self, j: usize, k: usize, p: &Vector2<f64>) -> Option<Foot<2>> {
+    /// The foot of `p` on the piece of arc j from its point k to k + 1, by Newton from the chord's nearest point.
+    /// Past an arc's end the face's curve goes on beyond a join, where it is not the part: the piece's nearest
+    /// point is then its end, itself a point examined. (A piece is 0.02 mm of a smooth curve: the distance along it
+    /// has one minimum, in Newton's reach from the chord's nearest point, or none inside it.)
+    fn foot_on_piece(&self, j: usize, k: usize, p: &Vector2<f64>) -> OnPiece {
         let points = &self.arcs[j].points;
         let (a, b) = (points[k], points[k + 1]);
         let chord = b - a;
         let length = chord.norm();
         let t = ((p - a).dot(&chord) / (length * length)).clamp(0.0, 1.0);
         let start = a + chord * t;
-        let foot = lagrange_newton(&self.faces[j], p, &start)?;
+        let Some(foot) = lagrange_newton(&self.faces[j], p, &start) else {
+            return OnPiece::Failed;
+        };
+        // Converged on another piece's critical point (that piece is examined for its own), or off the arc.
         let along = (foot.point - a).dot(&chord) / length;
         if (foot.point - start).norm() > 2.0 * length || along < -length || along > 2.0 * length {
-            return None;
+            return OnPiece::Elsewhere;
         }
         // The foot lies within a piece of piece k: it can only have run past an end from a piece beside one.
         let last = points.len() - 1;
         let before_start = k <= 1 && (foot.point - points[0]).dot(&(points[1] - points[0])) < 0.0;
         let after_end = k + 2 >= last
             && (foot.point - points[last]).dot(&(points[last] - points[last - 1])) > 0.0;
-        (!before_start && !after_end).then_some(foot)
+        if before_start || after_end {
+            OnPiece::Elsewhere
+        } else {
+            OnPiece::Foot(foot)
+        }
     }
+}
+
+/// What Newton found on one piece of a traced face.
+enum OnPiece {
+    Foot(Foot<2>),
+    /// Newton converged away from the piece, or past the arc's end: the piece's nearest point is one of its ends.
+    Elsewhere,
+    /// Newton did not converge.
+    Failed,
 }
 
 fn keep_nearer(best: &mut Option<Foot<2>>, candidate: Foot<2>) {
@@ -384,7 +424,7 @@ pub(crate) fn meeting_point(
         if (x - near).norm() > JOIN_SEARCH_MM || !x.iter().all(|c| c.is_finite()) {
             return None;
         }
-        if step.norm() < JOIN_TOLERANCE_MM {
+        if step.norm() <= JOIN_TOLERANCE * (1.0 + x.norm()) {
             return Some(x);
         }
     }

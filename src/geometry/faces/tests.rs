@@ -1,11 +1,10 @@
 use nalgebra::Vector2;
 use rand::{Rng, SeedableRng};
-use rand_distr::{Distribution, Normal};
 use zeroset_sim::naca::Naca4;
 
 use super::*;
+use crate::geometry::fit3l::tests::with_probe_noise;
 use crate::geometry::fit3l::FitMethod;
-use crate::geometry::normals::ordered_profile_normals;
 
 const AUTO: FacesFitOptions = FacesFitOptions {
     degree: None,
@@ -23,14 +22,7 @@ fn scanned(digits: &str, chord: f64, seed: u64) -> Vec<Vector2<f64>> {
         .into_iter()
         .map(Vector2::from)
         .collect();
-    let normals = ordered_profile_normals(&clean);
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let noise = Normal::new(0.0, 0.002).unwrap();
-    clean
-        .iter()
-        .zip(&normals)
-        .map(|(p, n)| p + n * noise.sample(&mut rng))
-        .collect()
+    with_probe_noise(&clean, 0.002, seed)
 }
 
 /// The true section: 20 000 points, cosine-spaced, so that they crowd at both edges.
@@ -56,6 +48,13 @@ fn naca_sections_with_sharp_trailing_edges_are_followed_within_5_um_to_their_edg
             .unwrap()
             .expect("a sharp trailing edge");
         assert_eq!(fitted.faces.len(), 3, "NACA {digits}");
+        // The two smooth joints: the faces either side pass within the noise of one another there.
+        assert_eq!(fitted.joint_gaps_mm.len(), 2, "NACA {digits}");
+        assert!(
+            fitted.joint_gaps_mm.iter().all(|g| *g < 0.005),
+            "NACA {digits} at {chord} mm: joints {:?} mm apart",
+            fitted.joint_gaps_mm
+        );
         let (worst, at) = truth(digits, chord)
             .iter()
             .map(|p| (fitted.model.foot(p).unwrap().distance.abs(), *p))
@@ -169,6 +168,7 @@ fn exact_distances_to_a_faced_section_match_a_dense_independent_reference() {
         checked += 1;
     }
     assert!(near_edge > 500, "{near_edge}");
+    assert_eq!(model.unproved(), 0);
 }
 
 #[test]

@@ -48,6 +48,19 @@ pub(crate) fn noisy(
         .collect()
 }
 
+/// Ordered points of a closed profile moved along its normals (from their order) by seeded Gaussian noise of
+/// `sigma` mm: a probe's noise on a scan.
+pub(crate) fn with_probe_noise(clean: &[Vector2<f64>], sigma: f64, seed: u64) -> Vec<Vector2<f64>> {
+    let normals = ordered_profile_normals(clean);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, sigma).unwrap();
+    clean
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| p + n * noise.sample(&mut rng))
+        .collect()
+}
+
 fn profile_3_truth() -> Vec<Vector2<f64>> {
     let model = published_profile_3();
     let start = project_to_zero_set(&model, &Vector2::new(100.0, 320.0), 50.0).unwrap();
@@ -85,15 +98,7 @@ pub(crate) fn naca_2412_truth_and_scan(
     let to_vector = |p: &[f64; 2]| Vector2::new(p[0], p[1]);
     let truth: Vec<Vector2<f64>> = foil.points(dense).iter().map(to_vector).collect();
     let clean: Vec<Vector2<f64>> = foil.points(count).iter().map(to_vector).collect();
-    let truth_normals = ordered_profile_normals(&clean);
-    let mut rng = rand::rngs::StdRng::seed_from_u64(2412);
-    let noise = Normal::new(0.0, 0.002).unwrap();
-    let measured = clean
-        .iter()
-        .zip(&truth_normals)
-        .map(|(p, n)| p + n * noise.sample(&mut rng))
-        .collect();
-    (truth, measured)
+    (truth, with_probe_noise(&clean, 0.002, 2412))
 }
 
 #[test]
@@ -275,14 +280,7 @@ mod properties {
                 Vector2::new(40.0 * r * t.cos(), 25.0 * r * t.sin())
             })
             .collect();
-        let normals = ordered_profile_normals(&clean);
-        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-        let noise = Normal::new(0.0, 0.002).unwrap();
-        clean
-            .iter()
-            .zip(&normals)
-            .map(|(p, n)| p + n * noise.sample(&mut rng))
-            .collect()
+        with_probe_noise(&clean, 0.002, 7)
     }
 
     proptest! {
