@@ -146,9 +146,29 @@ impl<const N: usize> Taylor<N> {
 
     /// A bound on |F(x0 + w) - F(x0)| over |w_k| <= r.
     pub(crate) fn variation(&self, r: f64) -> f64 {
+        self.variation_from(1, r)
+    }
+
+    /// The gradient at the expansion point.
+    pub(crate) fn gradient(&self) -> SVector<f64, N> {
+        SVector::from_fn(|a, _| {
+            let mut m = [0; N];
+            m[a] = 1;
+            self.coeff(m)
+        })
+    }
+
+    /// A bound on |F(x0 + w) - F(x0) - grad F(x0).w| over |w_k| <= r: how far F departs from its tangent plane.
+    pub(crate) fn curved_variation(&self, r: f64) -> f64 {
+        self.variation_from(2, r)
+    }
+
+    /// The centred form's bound on the terms of order `lowest` and up.
+    fn variation_from(&self, lowest: usize, r: f64) -> f64 {
         self.terms()
-            .filter(|(m, _)| m.iter().any(|&e| e > 0))
-            .map(|(m, q)| q.abs() * r.powi(m.iter().sum::<usize>() as i32))
+            .map(|(m, q)| (m.iter().sum::<usize>(), q))
+            .filter(|(order, _)| *order >= lowest)
+            .map(|(order, q)| q.abs() * r.powi(order as i32))
             .sum()
     }
 }

@@ -29,7 +29,7 @@ pub(crate) const TOLERANCE_MM: f64 = 1e-7;
 /// along a scan fall in it and need no expansion of their own.
 const FIRST_BALLS: [f64; 3] = [4.0, 2.0, 1.0];
 /// The smallest local ball tried before boxes, as a fraction of the disk's reach.
-const SMALLEST_BALL: f64 = 1.0 / 64.0;
+const SMALLEST_BALL: f64 = 1.0 / 1024.0;
 /// Boxes examined before a foot is left uncertified (each costs one Taylor expansion, one to a few microseconds):
 /// 512 for a curve, where the station measures every point live and a sharp edge's sliver would otherwise cost
 /// milliseconds a point, and 65 536 for a surface, whose boxes split in eight and cover an area, not a line.
@@ -53,6 +53,31 @@ const fn smallest_box(n: usize) -> f64 {
 }
 /// Other critical points of the distance, about as near as the foot, whose balls the boxes may leave out.
 const MAX_OTHER_FEET: usize = 8;
+
+/// The part of space where a model stands for the part: between two planes of constant x (a profile stack's
+/// segment). Zeros beyond them are not the part's and neither refute a foot nor need a proof.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Slab {
+    pub(crate) lo: f64,
+    pub(crate) hi: f64,
+}
+
+impl Slab {
+    /// Whether `x` (a coordinate along the slab's axis) lies in it, rounding allowed for.
+    fn holds(&self, x: f64) -> bool {
+        let rounding = 1e-12 * (1.0 + self.lo.abs().max(self.hi.abs()));
+        x >= self.lo - rounding && x <= self.hi + rounding
+    }
+
+    /// Whether the slab meets the x-range of a cube.
+    fn meets<const N: usize>(&self, centre: &SVector<f64, N>, half: f64) -> bool {
+        centre[0] + half >= self.lo && centre[0] - half <= self.hi
+    }
+}
+
+/// A ball about a point within which no zero (in the slab, if any) lies nearer to the point examined than its
+/// distance, less the tolerance: the search need not look there.
+type ClearBall<const N: usize> = (SVector<f64, N>, f64);
 
 /// What the certificate says of a foot.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,12 +118,26 @@ impl<const N: usize> HessianBound<N> {
 /// Certifies feet one after another; the Hessian bounds of the last ball are kept for the next foot.
 pub(crate) struct Certifier<'a, F, const N: usize> {
     f: &'a F,
+    slab: Option<Slab>,
     last: Option<HessianBound<N>>,
 }
 
 impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
     pub(crate) fn new(f: &'a F) -> Self {
-        Self { f, last: None }
+        Self {
+            f,
+            slab: None,
+            last: None,
+        }
+    }
+
+    /// A certifier for a model that stands for the part only within `slab`.
+    pub(crate) fn within(f: &'a F, slab: Slab) -> Self {
+        Self {
+            f,
+            slab: Some(slab),
+            last: None,
+        }
     }
 
     /// The verdict on `foot` (a point of the zero set, at signed distance `distance` from `p`).
@@ -120,6 +159,19 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
         distance: f64,
         value: f64,
         gradient: &SVector<f64, N>,
+    ) -> Verdict<N> {
+        self.check_beside(p, foot, distance, value, gradient, Vec::new())
+    }
+
+    /// The same, with `clear` balls already proved (a stack's creases).
+    pub(crate) fn check_beside(
+        &mut self,
+        p: &SVector<f64, N>,
+        foot: &SVector<f64, N>,
+        distance: f64,
+        value: f64,
+        gradient: &SVector<f64, N>,
+        mut clear: Vec<ClearBall<N>>,
     ) -> Verdict<N> {
         let d = distance.abs();
         if d <= TOLERANCE_MM {
@@ -143,7 +195,69 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
             }
         }
         let ball = self.largest_proven_ball(&local, &taylor, foot, reach / 2.0);
-        self.boxes(p, foot, d, ball)
+        clear.push((*foot, ball));
+        self.boxes(p, d, clear)
+    }
+
+    /// Whether no zero (in the slab) lies nearer to `p` than `d`, less the tolerance, when the foot at that distance
+    /// is not on this model: a stack's segment beside the one that holds the foot. `clear` as for
+    /// [`Self::check_beside`].
+    pub(crate) fn check_clear(
+        &self,
+        p: &SVector<f64, N>,
+        d: f64,
+        clear: Vec<ClearBall<N>>,
+    ) -> Verdict<N> {
+        if d <= TOLERANCE_MM {
+            return Verdict::Certified;
+        }
+        self.boxes(p, d, clear)
+    }
+
+    /// The ball about a crease foot `c` within which no zero on the slab's side of the crease lies nearer to `p`
+    /// than `d` (= |p - c|) less the tolerance; `None` where the proof does not hold. The crease is the curve where
+    /// the zero set meets the slab's face x = c.x, and c is its point nearest to p (its own certificate says so),
+    /// so p - c = lambda grad F + mu e_x with the in-plane part along the curve's normal. A zero c + u on the slab's
+    /// side (side * u_x >= 0) then has |p - c - u|^2 - d^2 = |u|^2 + 2 lambda F(c) + lambda u'H u - 2 mu u_x: where
+    /// mu points out of the slab the last term only helps, and the rest is the proof of an ordinary foot with
+    /// |lambda| |grad F| in place of the distance.
+    pub(crate) fn crease_ball(
+        &self,
+        p: &SVector<f64, N>,
+        c: &SVector<f64, N>,
+        d: f64,
+        side: f64,
+    ) -> Option<ClearBall<N>> {
+        let (value, gradient) = self.f.value_gradient(c);
+        let mut in_plane = gradient;
+        in_plane[0] = 0.0;
+        let squared = in_plane.norm_squared();
+        if !(squared > 0.0 && squared.is_finite()) || d <= TOLERANCE_MM {
+            return None;
+        }
+        let r = p - c;
+        let mut r_plane = r;
+        r_plane[0] = 0.0;
+        let lambda = r_plane.dot(&in_plane) / squared;
+        let mu = r[0] - lambda * gradient[0];
+        let gradient_norm = gradient.norm();
+        let normal = gradient / gradient_norm;
+        let local = Local {
+            d,
+            lever: lambda.abs() * gradient_norm,
+            gradient_norm,
+            normal,
+            off_zero_set: value.abs() / gradient_norm,
+            // 2 |lambda F(c)| and 2 (off-normal + outward mu) |u| are what the tolerance must absorb.
+            admissible: (lambda * value).abs() <= d * TOLERANCE_MM / 8.0
+                && (r_plane - in_plane * lambda).norm() + (side * mu).max(0.0)
+                    <= TOLERANCE_MM / 8.0,
+            side: if lambda < 0.0 { -1.0 } else { 1.0 },
+        };
+        let taylor = self.f.taylor(c)?;
+        let reach = 2.0 * d;
+        let radius = self.largest_proven_ball(&local, &taylor, c, reach);
+        (radius > 0.0).then_some((*c, radius))
     }
 
     /// The largest ball about `x`, from `radius` down by halves, within which `local`'s proof holds (0 if none).
@@ -169,9 +283,15 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
     /// foot: Newton from it finds that zero's own critical point, which is either nearer (the foot is refuted) or
     /// not, and then its own ball is proved and left out like the foot's (two feet equally near, across a
     /// medial axis).
-    fn boxes(&self, p: &SVector<f64, N>, foot: &SVector<f64, N>, d: f64, ball: f64) -> Verdict<N> {
+    fn boxes(&self, p: &SVector<f64, N>, d: f64, mut balls: Vec<ClearBall<N>>) -> Verdict<N> {
+        if balls
+            .iter()
+            .any(|(x, radius)| (x - p).norm() + d <= *radius)
+            || self.slab.is_some_and(|slab| !slab.meets(p, d))
+        {
+            return Verdict::Certified;
+        }
         let smallest = smallest_box(N) * d;
-        let mut balls = vec![(*foot, ball)];
         let mut queue = BinaryHeap::from([Cube::new(p, *p, d)]);
         let mut examined = 0;
         while let Some(Cube { centre, half, .. }) = queue.pop() {
@@ -188,13 +308,20 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
             let Some(taylor) = self.f.taylor(&centre) else {
                 return Verdict::Unknown;
             };
-            if taylor.value().abs() > taylor.variation(half) + taylor.rounding() {
+            if taylor.value().abs() > taylor.variation(half) + taylor.rounding()
+                || zeros_lie_beyond(&taylor, p, &centre, half, d - TOLERANCE_MM)
+            {
                 continue;
             }
             if half < smallest {
                 let Some(other) = lagrange_newton(self.f, p, &centre) else {
                     return Verdict::Unknown;
                 };
+                // A critical point beyond the slab is not the part's: the zero in the box is nearest to p at the
+                // slab's face, whose crease should have been proved clear.
+                if self.slab.is_some_and(|slab| !slab.holds(other.point[0])) {
+                    return Verdict::Unknown;
+                }
                 let other_d = other.distance.abs();
                 if other_d < d {
                     return Verdict::Nearer(other);
@@ -221,13 +348,46 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
                     }
                 });
                 let child = Cube::new(p, centre + offset, quarter);
-                if child.nearest < d - TOLERANCE_MM {
+                let in_slab = self
+                    .slab
+                    .is_none_or(|slab| slab.meets(&child.centre, quarter));
+                if in_slab && child.nearest < d - TOLERANCE_MM {
                     queue.push(child);
                 }
             }
         }
         Verdict::Certified
     }
+}
+
+/// Whether every zero in the cube about `centre` (half-side `half`) lies at least `reach` from p. The zeros lie
+/// within a thick plane: F(c + w) = F(c) + g.w + R with |R| bounded by the expansion's terms of order two and up,
+/// so n.w lies within w_n of -F(c)/|g|. Their distance from p is then at least that of p's component along n from
+/// the plane's thickness, and of its tangential component from the cube's shadow (a disk of the cube's
+/// half-diagonal). Near a foot, where the zero set runs at about the distance of p, this drops a cube an order of
+/// magnitude larger than the one that needs F not to vanish in it.
+fn zeros_lie_beyond<const N: usize>(
+    taylor: &Taylor<N>,
+    p: &SVector<f64, N>,
+    centre: &SVector<f64, N>,
+    half: f64,
+    reach: f64,
+) -> bool {
+    let gradient = taylor.gradient();
+    let gradient_norm = gradient.norm();
+    if !(gradient_norm > 0.0 && gradient_norm.is_finite()) {
+        return false;
+    }
+    let normal = gradient / gradient_norm;
+    let offset = -taylor.value() / gradient_norm;
+    let thickness = (taylor.curved_variation(half) + taylor.rounding()) / gradient_norm;
+    let q = p - centre;
+    let along = q.dot(&normal);
+    let across = (q - normal * along).norm();
+    let off_plane = ((along - offset).abs() - thickness).max(0.0);
+    let off_shadow = (across - half * (N as f64).sqrt()).max(0.0);
+    // A margin for the rounding of these sums.
+    (off_plane.powi(2) + off_shadow.powi(2)).sqrt() * (1.0 - 1e-12) >= reach
 }
 
 /// A cube of the search, ordered so that the one nearest to p comes first.
@@ -273,12 +433,14 @@ impl<const N: usize> Ord for Cube<N> {
 /// The foot's own quantities for the local proof.
 struct Local<const N: usize> {
     d: f64,
+    /// What the bending is weighed by: the distance along the normal (for a crease, |lambda| G).
+    lever: f64,
     gradient_norm: f64,
     normal: SVector<f64, N>,
     /// |F(x*)| / G: how far the foot may be off the zero set.
     off_zero_set: f64,
-    /// How far p lies off the foot's normal line (Newton's rounding).
-    off_normal: f64,
+    /// Whether the foot's own rounding (off the zero set, p off its normal line) is small enough for the proof.
+    admissible: bool,
     /// +1 where p lies along the gradient from the foot (outside), -1 inside.
     side: f64,
 }
@@ -294,12 +456,15 @@ impl<const N: usize> Local<N> {
         let gradient_norm = gradient.norm();
         let normal = gradient / gradient_norm;
         let offset = p - foot;
+        let off_zero_set = value.abs() / gradient_norm;
+        let off_normal = (offset - normal * offset.dot(&normal)).norm();
         Self {
             d,
+            lever: d,
             gradient_norm,
             normal,
-            off_zero_set: value.abs() / gradient_norm,
-            off_normal: (offset - normal * offset.dot(&normal)).norm(),
+            off_zero_set,
+            admissible: off_zero_set <= TOLERANCE_MM / 8.0 && off_normal <= TOLERANCE_MM / 8.0,
             side: if offset.dot(&normal) < 0.0 { -1.0 } else { 1.0 },
         }
     }
@@ -315,10 +480,7 @@ impl<const N: usize> Local<N> {
             extent <= 2.0 * self.d * (1.0 + 1e-12),
             "the proof holds within 2d"
         );
-        if !(self.gradient_norm > 0.0 && self.gradient_norm.is_finite()) {
-            return false;
-        }
-        if self.off_zero_set > TOLERANCE_MM / 8.0 || self.off_normal > TOLERANCE_MM / 8.0 {
+        if !(self.gradient_norm > 0.0 && self.gradient_norm.is_finite() && self.admissible) {
             return false;
         }
         let n = &self.normal;
@@ -344,7 +506,7 @@ impl<const N: usize> Local<N> {
         };
         let towards_p = -(along - 2.0 * lean * cross - lean * lean * normal - e);
         // A margin for the rounding of the expansion and of these sums.
-        self.d * towards_p <= self.gradient_norm * (1.0 - 1e-9)
+        self.lever * towards_p <= self.gradient_norm * (1.0 - 1e-9)
     }
 }
 
@@ -441,6 +603,90 @@ mod tests {
             certifier.check(&p, &Vector2::new(2.0, 0.0), -1.0),
             Verdict::Certified
         );
+    }
+
+    #[test]
+    fn a_cube_whose_zeros_all_lie_beyond_the_reach_is_dropped_though_the_model_vanishes_in_it() {
+        // The ellipse's zero set crosses each cube tried; the thick tangent plane says whether all of the zeros in
+        // it lie at least the reach from p. Each verdict is checked against the zeros themselves, traced densely.
+        let model = ellipse(50.0, 20.0);
+        let p = Vector2::new(0.0, 21.0);
+        let zeros: Vec<Vector2<f64>> = (0..200_000)
+            .map(|i| {
+                let t = i as f64 * std::f64::consts::TAU / 200_000.0;
+                Vector2::new(50.0 * t.cos(), 20.0 * t.sin())
+            })
+            .collect();
+        let mut dropped = 0;
+        for (along, half) in [
+            (2.0f64, 0.5),
+            (5.0, 1.0),
+            (10.0, 2.0),
+            (0.5, 0.25),
+            (20.0, 4.0),
+        ] {
+            let centre = Vector2::new(along, 20.0 * (1.0f64 - (along / 50.0).powi(2)).sqrt());
+            let taylor = model.taylor(&centre).unwrap();
+            assert!(
+                taylor.value().abs() <= taylor.variation(half),
+                "F vanishes in the cube"
+            );
+            let nearest_zero = zeros
+                .iter()
+                .filter(|z| (*z - centre).amax() <= half)
+                .map(|z| (p - z).norm())
+                .fold(f64::INFINITY, f64::min);
+            let reach = 1.0 + 1e-3;
+            let beyond = zeros_lie_beyond(&taylor, &p, &centre, half, reach);
+            if beyond {
+                dropped += 1;
+                assert!(
+                    nearest_zero >= reach,
+                    "a zero {nearest_zero} mm from p in the cube at {along}"
+                );
+            }
+        }
+        // The cubes to the side of the foot (0, 20) are dropped; one that holds it is not.
+        let holding = Vector2::new(0.1, 20.0);
+        assert!(!zeros_lie_beyond(
+            &model.taylor(&holding).unwrap(),
+            &p,
+            &holding,
+            0.25,
+            1.0 + 1e-3
+        ));
+        assert!(dropped >= 4, "{dropped} of 5 cubes dropped");
+    }
+
+    /// The plane y = 0 in 3-D, as a degree-1 model.
+    fn plane_y() -> IpModel<3> {
+        IpModel {
+            frame: Frame::identity(),
+            poly: Poly::new(1, vec![0.0, 0.0, 1.0, 0.0]),
+        }
+    }
+
+    #[test]
+    fn a_crease_foot_is_cleared_on_the_side_of_the_slab_it_bounds_and_not_on_the_other() {
+        // The half-plane y = 0, x >= 0, seen from p = (-1, 1, 0): its nearest point is the crease at the origin,
+        // at sqrt 2. On the slab's side the whole disk is cleared; on the other side (x <= 0) the plane comes
+        // nearer than the crease, at (-1, 0, 0), and the crease proof must refuse.
+        let model = plane_y();
+        let p = nalgebra::Vector3::new(-1.0, 1.0, 0.0);
+        let c = nalgebra::Vector3::zeros();
+        let d = 2f64.sqrt();
+        let within = Certifier::within(&model, Slab { lo: 0.0, hi: 10.0 });
+        let (_, radius) = within.crease_ball(&p, &c, d, 1.0).unwrap();
+        assert!(radius >= 2.0 * d - 1e-12, "{radius}");
+        assert_eq!(
+            within.check_clear(&p, d, vec![(c, radius)]),
+            Verdict::Certified
+        );
+        let beyond = Certifier::within(&model, Slab { lo: -10.0, hi: 0.0 });
+        assert_eq!(beyond.crease_ball(&p, &c, d, -1.0), None);
+        // Without the crease's ball, the boxes reach the face and Newton's foot (-1, 0, 0) lies beyond the slab:
+        // no proof either way.
+        assert_eq!(within.check_clear(&p, d, Vec::new()), Verdict::Unknown);
     }
 
     #[test]

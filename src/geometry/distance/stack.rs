@@ -1,11 +1,22 @@
 //! Exact distances to a profile stack. The stack is piecewise: each segment is a smooth 3-D polynomial between
 //! two profile planes, and the surface has a crease at every inner profile. Newton cannot converge on a crease,
 //! so the nearest point is found as the best of (a) each nearby segment's own foot, kept only when it lies within
-//! the segment's slab, and (b) the nearest point of each bounding profile curve, in its plane.
+//! the segment's slab, and (b) the nearest point of each profile curve, in its plane (a crease foot).
+//!
+//! The best is then proved the global minimum, segment by segment over every slab the disk about the point
+//! reaches: the certificate's box search ([`super::certificate`]) over the disk clipped to the closed slab, less
+//! the ball its proof clears about the foot when the foot is the segment's own, and the balls the crease proof
+//! clears about each bounding profile's nearest point. The boxes cover the slab's faces, so the profiles' curves
+//! are proved with it. A zero the boxes show nearer is a critical point of the segment's polynomial within its
+//! slab: it refutes the foot, and the proof starts again from it.
+
+use std::ops::RangeInclusive;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{Vector2, Vector3};
 
-use super::{DistanceError, ExactDistance, Foot};
+use super::certificate::{Certifier, Slab, Verdict};
+use super::{lagrange_newton, DistanceError, ExactDistance, Foot};
 use crate::geometry::implicit::{Implicit, IpModel};
 use crate::geometry::interp::ProfileStack;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
@@ -16,11 +27,23 @@ const SEGMENT_CELLS_ACROSS: usize = 256;
 const PROFILE_CELLS: usize = 512;
 /// Points this far beyond the first or last profile plane still count as on it (a probe's x scatters too).
 const PLANE_TOLERANCE_MM: f64 = 0.05;
+/// How many of each profile's samples nearest to a point seed its segments' Newton runs.
+const LIFTED_SEEDS: usize = 8;
+/// How many times a foot refuted by a segment's certificate is replaced by the nearer one and proved again.
+const REFUTATIONS_FOLLOWED: usize = 4;
 
 pub struct StackDistance<'a> {
     stack: &'a ProfileStack,
     segments: Vec<(IpModel<3>, ZeroSetSamples<3>)>,
     profiles: Vec<ZeroSetSamples<2>>,
+    uncertified: AtomicUsize,
+}
+
+/// Where a foot lies: within a segment (a critical point of its polynomial) or on a profile's curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum On {
+    Segment(usize),
+    Crease(usize),
 }
 
 impl<'a> StackDistance<'a> {
@@ -54,7 +77,13 @@ impl<'a> StackDistance<'a> {
             stack,
             segments,
             profiles,
+            uncertified: AtomicUsize::new(0),
         }
+    }
+
+    /// How many feet found so far could not be proved the global minimum.
+    pub fn uncertified(&self) -> usize {
+        self.uncertified.load(Ordering::Relaxed)
     }
 
     pub fn foot(&self, p: &Vector3<f64>) -> Result<Foot<3>, DistanceError> {
@@ -64,44 +93,208 @@ impl<'a> StackDistance<'a> {
         if p.x < first - PLANE_TOLERANCE_MM || p.x > last + PLANE_TOLERANCE_MM {
             return Err(DistanceError::OutsideModelRange);
         }
-        let k = self.stack.segment_at(p.x);
-        let side = self.stack.value(p);
-        let mut best: Option<Foot<3>> = None;
-        let mut consider = |candidate: Foot<3>| {
-            if best.is_none_or(|b| candidate.distance.abs() < b.distance.abs()) {
-                best = Some(candidate);
-            }
+        let mut search = Search {
+            stack: self,
+            p,
+            outside: self.stack.value(p) >= 0.0,
+            creases: vec![None; profiles.len()],
+            proved: true,
+            best: None,
         };
-        let first = k.saturating_sub(1);
-        let last = (k + 1).min(self.segments.len() - 1);
-        for j in first..=last {
-            let (model, samples) = &self.segments[j];
-            let (xa, xb) = (profiles[j].x, profiles[j + 1].x);
-            // The segment's polynomial stands for the part only between its planes: a nearer zero beyond them
-            // must not displace the foot within them, so the certificate (over the whole zero set) is not asked.
-            if let Ok(foot) = ExactDistance::new(model, samples).uncertified_foot(p, None) {
-                if foot.point.x >= xa && foot.point.x <= xb {
-                    consider(foot);
+        let k = self.stack.segment_at(p.x);
+        let around = k.saturating_sub(1)..=(k + 1).min(self.segments.len() - 1);
+        for j in around.clone() {
+            if let Some(foot) = self.segment_foot(j, p) {
+                search.consider(search.signed(foot.point), On::Segment(j));
+            }
+        }
+        // The profiles are creases of the surface: those within the best foot's distance are looked at as the
+        // proof goes; only where no segment has a foot within its slab do the point's own segment's profiles
+        // give the first one.
+        if search.best.is_none() {
+            search.crease(k);
+            search.crease(k + 1);
+        }
+        let found = search.prove();
+        if !search.proved {
+            self.uncertified.fetch_add(1, Ordering::Relaxed);
+        }
+        found
+    }
+
+    /// Segment j's own foot of p, the nearest of those Newton finds within the segment's slab from its seeds: the
+    /// seeded search over its sampled zero set, and its two profiles' samples nearest to p lifted to p's x. The
+    /// segment's samples lie in a few planes along x (each segment is long); the profiles' are dense, and a blade
+    /// changes slowly along its stack, so a lifted sample lies close to the segment's zero set beside p.
+    fn segment_foot(&self, j: usize, p: &Vector3<f64>) -> Option<Foot<3>> {
+        let (model, samples) = &self.segments[j];
+        let slab = self.slab(j);
+        let within = |foot: &Foot<3>| foot.point.x >= slab.lo && foot.point.x <= slab.hi;
+        // The segment's polynomial stands for the part only between its planes: its search is not certified over
+        // its whole zero set; the stack's own proof, clipped to the slab, follows.
+        let searched = ExactDistance::new(model, samples)
+            .uncertified_foot(p, None)
+            .ok()
+            .filter(within);
+        let x = p.x.clamp(slab.lo, slab.hi);
+        let lifted = [j, j + 1].into_iter().flat_map(|plane| {
+            self.profiles[plane]
+                .nearest_iter(&Vector2::new(p.y, p.z))
+                .take(LIFTED_SEEDS)
+        });
+        lifted
+            .filter_map(|seed| lagrange_newton(model, p, &Vector3::new(x, seed.x, seed.y)))
+            .filter(within)
+            .chain(searched)
+            .min_by(|a, b| a.distance.abs().total_cmp(&b.distance.abs()))
+    }
+
+    fn slab(&self, j: usize) -> Slab {
+        let profiles = self.stack.profiles();
+        Slab {
+            lo: profiles[j].x,
+            hi: profiles[j + 1].x,
+        }
+    }
+
+    /// The segments whose slabs come within `d` of x.
+    fn segments_within(&self, x: f64, d: f64) -> RangeInclusive<usize> {
+        let xs: Vec<f64> = self.stack.profiles().iter().map(|p| p.x).collect();
+        let last = self.segments.len() - 1;
+        let lo = (0..=last).find(|&j| xs[j + 1] >= x - d).unwrap_or(last);
+        let hi = (lo..=last).rev().find(|&j| xs[j] <= x + d).unwrap_or(lo);
+        lo..=hi
+    }
+}
+
+/// One point's search: the best foot so far, and each profile's nearest point once found.
+struct Search<'s, 'a> {
+    stack: &'s StackDistance<'a>,
+    p: &'s Vector3<f64>,
+    /// The side of p, which signs every foot (a crease foot has no one normal to sign it by).
+    outside: bool,
+    /// Each profile's nearest point to p in its plane, once looked for (`Some(None)`: it has none).
+    creases: Vec<Option<Option<Foot<3>>>>,
+    /// False once a proof could not be finished.
+    proved: bool,
+    best: Option<(Foot<3>, On)>,
+}
+
+impl Search<'_, '_> {
+    fn signed(&self, point: Vector3<f64>) -> Foot<3> {
+        let unsigned = (self.p - point).norm();
+        Foot {
+            point,
+            distance: if self.outside { unsigned } else { -unsigned },
+        }
+    }
+
+    /// Keeps `foot` if it is the nearest yet; says whether it was.
+    fn consider(&mut self, foot: Foot<3>, on: On) -> bool {
+        let nearer = self
+            .best
+            .is_none_or(|(b, _)| foot.distance.abs() < b.distance.abs());
+        if nearer {
+            self.best = Some((foot, on));
+        }
+        nearer
+    }
+
+    /// Profile `plane`'s nearest point to p, in its plane, looked for once and considered. Whether it is the
+    /// profile's nearest is for the segments' proofs to say (their slabs' faces hold the profile).
+    fn crease(&mut self, plane: usize) -> Option<Foot<3>> {
+        if let Some(known) = self.creases[plane] {
+            return known;
+        }
+        let profile = &self.stack.stack.profiles()[plane];
+        let exact = ExactDistance::new(&profile.model, &self.stack.profiles[plane]);
+        let found = exact
+            .foot(&Vector2::new(self.p.y, self.p.z), None)
+            .ok()
+            .map(|in_plane| {
+                self.signed(Vector3::new(profile.x, in_plane.point.x, in_plane.point.y))
+            });
+        self.creases[plane] = Some(found);
+        if let Some(foot) = found {
+            self.consider(foot, On::Crease(plane));
+            // A segment's own foot near its face is found best from the crease: the samples lie a few
+            // millimetres apart along x, and Newton from them can settle on a farther critical point.
+            let segments = plane.saturating_sub(1)..=plane.min(self.stack.segments.len() - 1);
+            for j in segments {
+                let (model, _) = &self.stack.segments[j];
+                if let Some(inner) = lagrange_newton(model, self.p, &foot.point) {
+                    let slab = self.stack.slab(j);
+                    if slab.lo <= inner.point.x && inner.point.x <= slab.hi {
+                        self.consider(self.signed(inner.point), On::Segment(j));
+                    }
                 }
             }
         }
-        let planes = profiles
-            .iter()
-            .zip(&self.profiles)
-            .skip(first)
-            .take(last + 2 - first);
-        for (plane, plane_samples) in planes {
-            let exact = ExactDistance::new(&plane.model, plane_samples);
-            if let Ok(in_plane) = exact.foot(&Vector2::new(p.y, p.z), None) {
-                let point = Vector3::new(plane.x, in_plane.point.x, in_plane.point.y);
-                let unsigned = (p - point).norm();
-                consider(Foot {
-                    point,
-                    distance: if side < 0.0 { -unsigned } else { unsigned },
-                });
+        found
+    }
+
+    /// Proves the best foot over every slab within its distance, following any nearer zero a proof shows.
+    fn prove(&mut self) -> Result<Foot<3>, DistanceError> {
+        'rounds: for _ in 0..=REFUTATIONS_FOLLOWED {
+            let Some((best, on)) = self.best else {
+                return Err(DistanceError::NoFootPoint);
+            };
+            let d = best.distance.abs();
+            let segments = self.stack.segments_within(self.p.x, d);
+            let profiles = self.stack.stack.profiles();
+            let planes = *segments.start()..=*segments.end() + 1;
+            for (plane, profile) in profiles
+                .iter()
+                .enumerate()
+                .take(planes.end() + 1)
+                .skip(*planes.start())
+            {
+                if (profile.x - self.p.x).abs() < d {
+                    self.crease(plane);
+                }
             }
+            if self
+                .best
+                .is_some_and(|(nearest, _)| nearest.distance.abs() < d)
+            {
+                continue 'rounds;
+            }
+            for j in segments {
+                let (model, _) = &self.stack.segments[j];
+                let mut certifier = Certifier::within(model, self.stack.slab(j));
+                // A crease's ball clears the segment's side of it (plane j bounds the slab below, j + 1 above).
+                let clear = [(j, 1.0), (j + 1, -1.0)]
+                    .into_iter()
+                    .filter_map(|(plane, side)| {
+                        // A profile beyond the disk's reach bounds nothing the disk holds.
+                        if (profiles[plane].x - self.p.x).abs() >= d {
+                            return None;
+                        }
+                        let crease = self.creases[plane].flatten()?;
+                        certifier.crease_ball(self.p, &crease.point, crease.distance.abs(), side)
+                    })
+                    .collect::<Vec<_>>();
+                let verdict = if on == On::Segment(j) {
+                    let (value, gradient) = model.value_gradient(&best.point);
+                    certifier.check_beside(self.p, &best.point, d, value, &gradient, clear)
+                } else {
+                    certifier.check_clear(self.p, d, clear)
+                };
+                match verdict {
+                    Verdict::Certified => {}
+                    Verdict::Nearer(nearer) => {
+                        self.consider(self.signed(nearer.point), On::Segment(j));
+                        continue 'rounds;
+                    }
+                    Verdict::Unknown => self.proved = false,
+                }
+            }
+            return Ok(best);
         }
-        best.ok_or(DistanceError::NoFootPoint)
+        self.proved = false;
+        self.best
+            .map(|(foot, _)| foot)
+            .ok_or(DistanceError::NoFootPoint)
     }
 }
 
@@ -120,6 +313,154 @@ mod tests {
                 vec![-radius / 2.0, 0.0, 0.0, 0.5 / radius, 0.0, 0.5 / radius],
             ),
         }
+    }
+
+    /// The stack fitted (degree 8, `zeroset fit ip --stack`) to the simulated blade's five NACA profiles: thin
+    /// sections whose far faces and trailing edges are within reach of points a few millimetres away.
+    fn blade_stack() -> (ProfileStack, Vec<Aabb<2>>) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("config/models/naca-blade-a-stack-degree-8.json");
+        let file = crate::model_file::ModelFile::load(&path).unwrap();
+        let crate::model_file::ReferenceModel::Stack { mut profiles } = file.model else {
+            panic!("{} holds no stack", path.display());
+        };
+        profiles.sort_by(|a, b| a.x.total_cmp(&b.x));
+        let domains = profiles.iter().map(|p| p.fitted.domain).collect();
+        (crate::model_file::stack_of(&profiles).unwrap(), domains)
+    }
+
+    /// Points of every segment's zero set within its slab, sampled densely (about 0.7 mm apart across, 2 mm along
+    /// x), each tagged with its segment: every one is a point of the stack's surface.
+    fn dense_surface(stack: &ProfileStack, domains: &[Aabb<2>]) -> Vec<(Vector3<f64>, usize)> {
+        let bounds = stack.bounds(domains);
+        let xs: Vec<f64> = stack.profiles().iter().map(|p| p.x).collect();
+        (0..xs.len() - 1)
+            .flat_map(|k| {
+                let model = stack.segment_model(k);
+                let slab = Aabb {
+                    min: Vector3::new(xs[k], bounds.min.y, bounds.min.z),
+                    max: Vector3::new(xs[k + 1], bounds.max.y, bounds.max.z),
+                };
+                let along = ((xs[k + 1] - xs[k]) / 2.0).ceil() as usize;
+                let samples = ZeroSetSamples::with_counts(&model, &slab, [along, 200, 200]);
+                samples
+                    .points()
+                    .iter()
+                    .filter(|q| q.x >= xs[k] && q.x <= xs[k + 1])
+                    .map(|q| (*q, k))
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn distances_to_a_fitted_blade_stack_are_certified_global_minima() {
+        check_against_the_sampled_surface(500, 2412);
+    }
+
+    /// The issue's campaign: `cargo test --release --lib blade_stack_campaign -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "100 000 points: minutes in a release build"]
+    fn blade_stack_campaign() {
+        check_against_the_sampled_surface(100_000, 7);
+    }
+
+    /// Points where the stack's distance before its certificate took a local foot (found by this check over
+    /// 30 000 points, seed 2412): 0.1-1.3 mm too far, near the blade's leading edge and inside the section.
+    const ONCE_LOCAL: [[f64; 3]; 6] = [
+        [200.710583, 56.273681, 28.711699],
+        [195.177994, 59.675462, 38.718937],
+        [105.644125, 82.587812, 50.062777],
+        [471.429911, -35.242767, -11.787687],
+        [399.706357, 73.600185, 33.324518],
+        [101.970601, 77.573251, 48.731551],
+    ];
+
+    /// An independent check of the stack's distances: before its certificate, 6 of 30 000 points within 5 mm of
+    /// this stack took a local foot, up to 1.3 mm too far ([`ONCE_LOCAL`]). Here: those, then `count` seeded
+    /// points within 5 mm, each foot on the surface, no farther than any point sampled on it, nor than 1e-6 mm
+    /// beyond the 24 samples nearest to p each polished by Newton on its own segment; and every foot proved.
+    fn check_against_the_sampled_surface(count: usize, seed: u64) {
+        use rand::{Rng, SeedableRng};
+        let (stack, domains) = blade_stack();
+        let distance = StackDistance::new(&stack, &domains);
+        let surface = dense_surface(&stack, &domains);
+        let tree = rstar::RTree::bulk_load(
+            surface
+                .iter()
+                .enumerate()
+                .map(|(i, (q, _))| rstar::primitives::GeomWithData::new([q.x, q.y, q.z], i))
+                .collect(),
+        );
+        let models: Vec<IpModel<3>> = (0..4).map(|k| stack.segment_model(k)).collect();
+        let (first, last) = (stack.profiles()[0].x, stack.profiles()[4].x);
+        // Checks one point; false if it lies more than 5 mm from the surface.
+        let check = |p: Vector3<f64>| {
+            // The sampled surface's nearest points, polished on their segments within their slabs.
+            let mut sampled = f64::INFINITY;
+            let mut polished = f64::INFINITY;
+            for q in tree.nearest_neighbor_iter([p.x, p.y, p.z]).take(24) {
+                let (point, k) = surface[q.data];
+                sampled = sampled.min((p - point).norm());
+                let slab = stack.profiles()[k].x..=stack.profiles()[k + 1].x;
+                if let Some(foot) =
+                    crate::geometry::distance::lagrange_newton(&models[k], &p, &point)
+                {
+                    if slab.contains(&foot.point.x) {
+                        polished = polished.min(foot.distance.abs());
+                    }
+                }
+            }
+            if sampled > 5.0 {
+                return None;
+            }
+            let foot = distance.foot(&p).unwrap();
+            let d = foot.distance.abs();
+            assert!(
+                d <= sampled + 1e-9,
+                "at {p}: the foot {} lies {d} mm away, a surface point {sampled} mm",
+                foot.point
+            );
+            assert!(
+                d <= polished + 1e-6,
+                "at {p}: {d} mm against the polished {polished} mm"
+            );
+            let (value, gradient) = stack.value_gradient(&foot.point);
+            assert!(
+                value.abs() / gradient.norm() < 1e-6
+                    && foot.point.x >= first
+                    && foot.point.x <= last,
+                "at {p}: the foot {} is off the surface",
+                foot.point
+            );
+            assert_eq!(foot.distance.signum(), stack.value(&p).signum(), "at {p}");
+            Some(foot.distance)
+        };
+        for p in ONCE_LOCAL {
+            assert!(check(Vector3::from(p)).is_some(), "{p:?} lies within 5 mm");
+        }
+        let bounds = stack.bounds(&domains).scaled(0.6);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let (mut checked, mut inside) = (0, 0);
+        while checked < count {
+            let p = Vector3::new(
+                rng.gen_range(first..last),
+                rng.gen_range(bounds.min.y..bounds.max.y),
+                rng.gen_range(bounds.min.z..bounds.max.z),
+            );
+            if let Some(signed) = check(p) {
+                checked += 1;
+                inside += usize::from(signed < -1.0);
+            }
+        }
+        println!(
+            "{checked} points within 5 mm of the stack, {inside} more than 1 mm inside, against {} surface samples: \
+             {} unproved",
+            surface.len(),
+            distance.uncertified()
+        );
+        assert!(inside > count / 20, "{inside} points more than 1 mm inside");
+        assert_eq!(distance.uncertified(), 0, "of {checked}");
     }
 
     #[test]
