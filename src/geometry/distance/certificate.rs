@@ -148,23 +148,12 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
         distance: f64,
     ) -> Verdict<N> {
         let (value, gradient) = self.f.value_gradient(foot);
-        self.check_at(p, foot, distance, value, &gradient)
+        self.check_at(p, foot, distance, value, &gradient, Vec::new())
     }
 
-    /// The same, given the model's value and gradient at the foot.
+    /// The same, given the model's value and gradient at the foot, and `clear` balls already proved (a stack's
+    /// creases).
     pub(crate) fn check_at(
-        &mut self,
-        p: &SVector<f64, N>,
-        foot: &SVector<f64, N>,
-        distance: f64,
-        value: f64,
-        gradient: &SVector<f64, N>,
-    ) -> Verdict<N> {
-        self.check_beside(p, foot, distance, value, gradient, Vec::new())
-    }
-
-    /// The same, with `clear` balls already proved (a stack's creases).
-    pub(crate) fn check_beside(
         &mut self,
         p: &SVector<f64, N>,
         foot: &SVector<f64, N>,
@@ -201,7 +190,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
 
     /// Whether no zero (in the slab) lies nearer to `p` than `d`, less the tolerance, when the foot at that distance
     /// is not on this model: a stack's segment beside the one that holds the foot. `clear` as for
-    /// [`Self::check_beside`].
+    /// [`Self::check_at`].
     pub(crate) fn check_clear(
         &self,
         p: &SVector<f64, N>,

@@ -84,7 +84,14 @@ impl<'a, F: Implicit<N>, const N: usize> ExactDistance<'a, F, N> {
         if let Some((prev_point, prev_foot)) = previous {
             let start = prev_foot.point + (p - prev_point);
             if let Some(c) = lagrange_newton_with_gradient(self.f, p, &start, STEP_TOLERANCE_MM) {
-                match certifier.check_at(p, &c.foot.point, c.foot.distance, c.value, &c.gradient) {
+                match certifier.check_at(
+                    p,
+                    &c.foot.point,
+                    c.foot.distance,
+                    c.value,
+                    &c.gradient,
+                    Vec::new(),
+                ) {
                     Verdict::Certified => return Ok(c.foot),
                     Verdict::Nearer(nearer) => refuted_by = Some(nearer),
                     Verdict::Unknown => judged = Some((c.foot.point, Verdict::Unknown)),

@@ -301,7 +301,7 @@ impl Search<'_, '_> {
                     .collect::<Vec<_>>();
                 let verdict = if on == On::Segment(j) {
                     let (value, gradient) = model.value_gradient(&best.point);
-                    certifier.check_beside(self.p, &best.point, d, value, &gradient, clear)
+                    certifier.check_at(self.p, &best.point, d, value, &gradient, clear)
                 } else {
                     certifier.check_clear(self.p, d, clear)
                 };
