@@ -214,15 +214,14 @@ impl Search<'_, '_> {
         }
     }
 
-    /// Keeps `foot` if it is the nearest yet; says whether it was.
-    fn consider(&mut self, foot: Foot<3>, on: On) -> bool {
-        let nearer = self
+    /// Keeps `foot` if it is the nearest yet.
+    fn consider(&mut self, foot: Foot<3>, on: On) {
+        if self
             .best
-            .is_none_or(|(b, _)| foot.distance.abs() < b.distance.abs());
-        if nearer {
+            .is_none_or(|(b, _)| foot.distance.abs() < b.distance.abs())
+        {
             self.best = Some((foot, on));
         }
-        nearer
     }
 
     /// Profile `plane`'s nearest point to p, in its plane, looked for once and considered. Whether it is the
