@@ -298,7 +298,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
                 return Verdict::Unknown;
             };
             if taylor.value().abs() > taylor.variation(half) + taylor.rounding()
-                || zeros_lie_beyond(&taylor, p, &centre, half, d - TOLERANCE_MM)
+                || zeros_lie_beyond(&taylor, p, &centre, half, self.slab, d - TOLERANCE_MM)
             {
                 continue;
             }
@@ -349,17 +349,20 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
     }
 }
 
-/// Whether every zero in the cube about `centre` (half-side `half`) lies at least `reach` from p. The zeros lie
-/// within a thick plane: F(c + w) = F(c) + g.w + R with |R| bounded by the expansion's terms of order two and up,
-/// so n.w lies within w_n of -F(c)/|g|. Their distance from p is then at least that of p's component along n from
-/// the plane's thickness, and of its tangential component from the cube's shadow (a disk of the cube's
-/// half-diagonal). Near a foot, where the zero set runs at about the distance of p, this drops a cube an order of
-/// magnitude larger than the one that needs F not to vanish in it.
+/// Whether every zero in the cube about `centre` (half-side `half`), within the slab if any, lies at least `reach`
+/// from p. The zeros lie within a thick plane: F(c + w) = F(c) + g.w + R with |R| bounded by the expansion's terms
+/// of order two and up, so n.w lies within the thickness of -F(c)/|g|. Their distance from p is then at least that
+/// of p's component along n from the thick plane, and of its tangential component from the box's shadow, taken
+/// along the tangential direction from the box to p (the box's support there). The box is the cube cut to the
+/// slab: at a crease, p lies off the slab's face, and what is left of a cube across the face lies away from p.
+/// Near a foot, where the zero set runs at about the distance of p, this drops a cube an order of magnitude larger
+/// than the one that needs F not to vanish in it.
 fn zeros_lie_beyond<const N: usize>(
     taylor: &Taylor<N>,
     p: &SVector<f64, N>,
     centre: &SVector<f64, N>,
     half: f64,
+    slab: Option<Slab>,
     reach: f64,
 ) -> bool {
     let gradient = taylor.gradient();
@@ -370,11 +373,27 @@ fn zeros_lie_beyond<const N: usize>(
     let normal = gradient / gradient_norm;
     let offset = -taylor.value() / gradient_norm;
     let thickness = (taylor.curved_variation(half) + taylor.rounding()) / gradient_norm;
-    let q = p - centre;
-    let along = q.dot(&normal);
-    let across = (q - normal * along).norm();
+    let along = (p - centre).dot(&normal);
     let off_plane = ((along - offset).abs() - thickness).max(0.0);
-    let off_shadow = (across - half * (N as f64).sqrt()).max(0.0);
+    // The box: the cube, cut along x to the slab.
+    let (mut lo, mut hi) = (centre.add_scalar(-half), centre.add_scalar(half));
+    if let Some(slab) = slab {
+        lo[0] = lo[0].max(slab.lo);
+        hi[0] = hi[0].min(slab.hi);
+        if lo[0] > hi[0] {
+            return true;
+        }
+    }
+    let (middle, halves) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
+    let q = p - middle;
+    let tangential = q - normal * q.dot(&normal);
+    let across = tangential.norm();
+    let support = if across > 0.0 {
+        (tangential / across).abs().dot(&halves)
+    } else {
+        0.0
+    };
+    let off_shadow = (across - support).max(0.0);
     // A margin for the rounding of these sums.
     (off_plane.powi(2) + off_shadow.powi(2)).sqrt() * (1.0 - 1e-12) >= reach
 }
@@ -626,7 +645,7 @@ mod tests {
                 .map(|z| (p - z).norm())
                 .fold(f64::INFINITY, f64::min);
             let reach = 1.0 + 1e-3;
-            let beyond = zeros_lie_beyond(&taylor, &p, &centre, half, reach);
+            let beyond = zeros_lie_beyond(&taylor, &p, &centre, half, None, reach);
             if beyond {
                 dropped += 1;
                 assert!(
@@ -642,6 +661,7 @@ mod tests {
             &p,
             &holding,
             0.25,
+            None,
             1.0 + 1e-3
         ));
         assert!(dropped >= 4, "{dropped} of 5 cubes dropped");
@@ -673,9 +693,14 @@ mod tests {
         );
         let beyond = Certifier::within(&model, Slab { lo: -10.0, hi: 0.0 });
         assert_eq!(beyond.crease_ball(&p, &c, d, -1.0), None);
-        // Without the crease's ball, the boxes reach the face and Newton's foot (-1, 0, 0) lies beyond the slab:
-        // no proof either way.
-        assert_eq!(within.check_clear(&p, d, Vec::new()), Verdict::Unknown);
+        // Without the crease's ball, the boxes cut to the slab prove it too (the cut boxes lie away from p); but
+        // claimed at a distance the origin beats, no proof: the boxes close in on it, and Newton's foot from
+        // there, (-1, 0, 0), lies beyond the slab.
+        assert_eq!(within.check_clear(&p, d, Vec::new()), Verdict::Certified);
+        assert_eq!(
+            within.check_clear(&p, d + 0.1, Vec::new()),
+            Verdict::Unknown
+        );
     }
 
     #[test]
