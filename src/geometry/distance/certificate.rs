@@ -205,8 +205,9 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
 
     /// The ball about a crease foot `c` within which no zero on the slab's side of the crease lies nearer to `p`
     /// than `d` (= |p - c|) less the tolerance; `None` where the proof does not hold. The crease is the curve where
-    /// the zero set meets the slab's face x = c.x, and c is its point nearest to p (its own certificate says so),
-    /// so p - c = lambda grad F + mu e_x with the in-plane part along the curve's normal. A zero c + u on the slab's
+    /// the zero set meets the slab's face x = c.x, and c is a critical point of the distance from p along it (a
+    /// Newton foot in that plane; the proof needs no more), so p - c = lambda grad F + mu e_x with the in-plane part
+    /// along the curve's normal. A zero c + u on the slab's
     /// side (side * u_x >= 0) then has |p - c - u|^2 - d^2 = |u|^2 + 2 lambda F(c) + lambda u'H u - 2 mu u_x: where
     /// mu points out of the slab the last term only helps, and the rest is the proof of an ordinary foot with
     /// |lambda| |grad F| in place of the distance.

@@ -184,10 +184,15 @@ impl<'a> StackDistance<'a> {
 
     /// The segments whose slabs come within `d` of x.
     fn segments_within(&self, x: f64, d: f64) -> RangeInclusive<usize> {
-        let xs: Vec<f64> = self.stack.profiles().iter().map(|p| p.x).collect();
+        let profiles = self.stack.profiles();
         let last = self.segments.len() - 1;
-        let lo = (0..=last).find(|&j| xs[j + 1] >= x - d).unwrap_or(last);
-        let hi = (lo..=last).rev().find(|&j| xs[j] <= x + d).unwrap_or(lo);
+        let lo = (0..=last)
+            .find(|&j| profiles[j + 1].x >= x - d)
+            .unwrap_or(last);
+        let hi = (lo..=last)
+            .rev()
+            .find(|&j| profiles[j].x <= x + d)
+            .unwrap_or(lo);
         lo..=hi
     }
 }
