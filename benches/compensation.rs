@@ -30,7 +30,7 @@ fn per_point(c: &mut Criterion) {
             let mut compensator = Compensator::new(CompensationSettings::new(1.0), Vector3::z());
             let mut fitted = 0;
             for (centre, normal) in &scan {
-                if let Some(point) = compensator.push(black_box(*centre), black_box(*normal)) {
+                for point in compensator.push(black_box(*centre), black_box(*normal)) {
                     fitted += usize::from(!point.is_flagged());
                 }
             }

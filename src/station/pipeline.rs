@@ -169,8 +169,7 @@ impl Pipeline {
                     profile.waiting.push_back(received_us);
                     let _ = recorder.send(Record::Point { key, raw }).await;
                     let centre = Point3::from(raw.centre);
-                    if let Some(point) = profile.compensator.push(centre, Vector3::from(raw.normal))
-                    {
+                    for point in profile.compensator.push(centre, Vector3::from(raw.normal)) {
                         self.publish(key, profile, point);
                     }
                     if let Some(preview) = profile.compensator.preview() {

@@ -55,7 +55,8 @@
 //! centres lie on one circle, and the contact comes from that circle, fitted to the roll's centres up to the
 //! look-ahead, instead of the quartic (see `roll` for why the quartic fails there).
 //!
-//! Streaming: a point is compensated once the K = 4 points after it have arrived. The first and last K points of an
+//! Streaming: a point is compensated once the K = 4 points after it have arrived (the first points of a roll that
+//! starts in small steps wait longer, until the roll shows where its edge is: see [`ROLL_REACH_AHEAD`]). The first and last K points of an
 //! open path have no symmetric window and use the reported normal, as do points where the fit cannot work. Until
 //! then a point has a provisional compensation, from the window that ends at it ([`Compensator::preview`]): a
 //! machine sends its points in lines of several, so the last K of a line would otherwise wait a whole line for
@@ -65,16 +66,28 @@ mod roll;
 
 use nalgebra::{Point3, SMatrix, SVector, Unit, Vector2, Vector3};
 
-use roll::{roll_through, RollSample, REACH_BACK};
+use roll::{roll_through, RollSample, RollThrough, REACH_BACK};
 
 /// Points on each side of the one being compensated: the look-ahead, in points.
 pub const LOOK_AHEAD: usize = 4;
 
+/// The most points a roll's first points may wait for, beyond which they take the quartic. A roll that starts in
+/// small steps (the ball turning 2 to 5 deg per point onto a blade's trailing edge, as a scan planned on the
+/// nominal does round a section turned from it) has not turned far enough within the look-ahead for its circle to
+/// place the edge along the face: the sharp edge's circle over 16 deg of centres puts it within about 9 um (one
+/// sigma at 2 um noise), and the quartic, whose window straddles the roll's start, 20 um proud of it. Those points
+/// wait until the roll has turned through enough, as long as its centres stay on one circle.
+const ROLL_REACH_AHEAD: usize = 24;
+
 /// Points in a fitting window.
 const WINDOW: usize = 2 * LOOK_AHEAD + 1;
 
-/// Samples kept: a window, and the centres before it that a roll round an edge may reach back to.
-const HISTORY: usize = WINDOW + REACH_BACK;
+/// Centres before a point that its compensation sees: the quartic's half window, and the centres before it that a
+/// roll round an edge may reach back to.
+const BEHIND: usize = LOOK_AHEAD + REACH_BACK;
+
+/// Samples kept: those a point's compensation sees behind it, the point, and the most it may wait for.
+const HISTORY: usize = BEHIND + 1 + ROLL_REACH_AHEAD;
 
 /// Coefficients of the quartic.
 const TERMS: usize = 5;
@@ -199,6 +212,11 @@ pub struct Compensator {
     recent: Vec<Sample>,
     /// Samples received so far.
     received: usize,
+    /// The next point to compensate: every point before it is out.
+    next: usize,
+    /// The point waiting for its roll and the look-ahead up to which its centres were all too short a roll
+    /// (the same centres say the same, so they are not asked again).
+    waiting_roll: Option<(usize, usize)>,
 }
 
 impl Compensator {
@@ -209,35 +227,60 @@ impl Compensator {
             plane_normal: Unit::new_normalize(plane_normal),
             recent: Vec::with_capacity(HISTORY),
             received: 0,
+            next: 0,
+            waiting_roll: None,
         }
     }
 
     /// Takes the next ball centre and reported normal; returns the points now compensated, in scan order: none
-    /// while the look-ahead fills, then one per point.
-    pub fn push(
-        &mut self,
-        centre: Point3<f64>,
-        reported_normal: Vector3<f64>,
-    ) -> Option<Compensated> {
+    /// while the look-ahead fills, then one per point, except that the first points of a roll round an edge may
+    /// wait for up to [`ROLL_REACH_AHEAD`] points and then come out together.
+    pub fn push(&mut self, centre: Point3<f64>, reported_normal: Vector3<f64>) -> Vec<Compensated> {
         let sample = self.sample(centre, reported_normal);
         if self.recent.len() == HISTORY {
             self.recent.remove(0);
         }
         self.recent.push(sample);
         self.received += 1;
-        let index = self.received - 1;
-        if index < LOOK_AHEAD {
+        let newest = self.received - 1;
+        if newest < LOOK_AHEAD {
             // The path's start: no points behind it. Compensated at once, so the live delay stays one window.
-            return Some(self.reported(index, &sample, Method::Reported(Fallback::PathEnd)));
+            self.next = self.received;
+            return vec![self.reported(newest, &sample, Method::Reported(Fallback::PathEnd))];
         }
-        if self.recent.len() < WINDOW {
-            return None;
+        let mut out = Vec::new();
+        while self.next + LOOK_AHEAD <= newest {
+            let Some(point) = self.settled(self.next, true) else {
+                break;
+            };
+            out.push(point);
+            self.next += 1;
         }
-        Some(self.fitted(
-            index - LOOK_AHEAD,
-            &self.recent,
-            self.recent.len() - 1 - LOOK_AHEAD,
-        ))
+        out
+    }
+
+    /// The point `index` compensated from the samples kept, or `None` if `may_wait` and its roll is too short
+    /// yet to say where the edge is.
+    fn settled(&mut self, index: usize, may_wait: bool) -> Option<Compensated> {
+        let oldest = self.received - self.recent.len();
+        let at = index - oldest;
+        let from = at.saturating_sub(BEHIND);
+        let known_short = match self.waiting_roll {
+            Some((waiting, ahead)) if waiting == index => ahead,
+            _ => 0,
+        };
+        let compensated = self.compensated(
+            index,
+            &self.recent[from..],
+            at - from,
+            known_short,
+            may_wait,
+        );
+        self.waiting_roll = match compensated {
+            None => Some((index, self.received - 1 - index)),
+            Some(_) => None,
+        };
+        compensated
     }
 
     /// The newest point's provisional compensation, while its final one waits for the look-ahead: from the
@@ -258,22 +301,29 @@ impl Compensator {
             let sample = self.recent.last()?;
             return Some(self.reported(newest, sample, Method::Reported(Fallback::PathEnd)));
         }
-        Some(self.fitted(newest, &self.recent, self.recent.len() - 1))
+        let at = self.recent.len() - 1;
+        let from = at.saturating_sub(BEHIND);
+        self.compensated(newest, &self.recent[from..], at - from, 0, false)
     }
 
-    /// Ends the path: returns the points still waiting for their look-ahead (the path's end, along the reported
-    /// normals). The next point pushed starts a new path.
+    /// Ends the path: returns the points still to come out, in scan order: those waiting for a roll from what
+    /// came, the last `LOOK_AHEAD` along their reported normals (the path's end). The next point pushed starts a
+    /// new path.
     pub fn finish(&mut self) -> Vec<Compensated> {
-        let first_waiting = self.received.saturating_sub(LOOK_AHEAD).max(LOOK_AHEAD);
-        let buffered_from = self.received - self.recent.len();
-        let rest = (first_waiting..self.received)
-            .map(|index| {
-                let sample = self.recent[index - buffered_from];
-                self.reported(index, &sample, Method::Reported(Fallback::PathEnd))
-            })
-            .collect();
+        let mut rest = Vec::new();
+        while self.next + LOOK_AHEAD < self.received {
+            rest.extend(self.settled(self.next, false));
+            self.next += 1;
+        }
+        let oldest = self.received - self.recent.len();
+        rest.extend((self.next..self.received).map(|index| {
+            let sample = self.recent[index - oldest];
+            self.reported(index, &sample, Method::Reported(Fallback::PathEnd))
+        }));
         self.recent.clear();
         self.received = 0;
+        self.next = 0;
+        self.waiting_roll = None;
         rest
     }
 
@@ -318,13 +368,46 @@ impl Compensator {
         }
     }
 
-    /// The point at `at` of `history` (the samples up to the newest, at least a window of them; the point is the
-    /// last window's middle, or its end for a preview): from the circle of a roll round an edge through it, if
-    /// there is one, else from the quartic fit of the last window's centre path in a frame about the point.
-    fn fitted(&self, index: usize, history: &[Sample], at: usize) -> Compensated {
-        if let Some(rolled) = self.rolled(index, history, at) {
-            return rolled;
+    /// The point at `at` of `history` (the samples that the point's compensation sees, at least a window of
+    /// them, the newest last; the point has `LOOK_AHEAD` or more after it, or none for a preview): from the circle
+    /// of a roll round an edge through it, if there is one, else from the quartic fit of the window about it (the
+    /// window that ends at it, for a preview) in a frame about the point.
+    ///
+    /// The roll is looked for with the look-ahead, then with each point after it in turn until the centres say
+    /// whether it is one (already known too short a roll up to `known_short` points ahead). Where they cannot
+    /// tell yet, the point waits (`None`) if `may_wait` and it has waited less than [`ROLL_REACH_AHEAD`] points:
+    /// streaming or at once, a point comes out the same.
+    fn compensated(
+        &self,
+        index: usize,
+        history: &[Sample],
+        at: usize,
+        known_short: usize,
+        may_wait: bool,
+    ) -> Option<Compensated> {
+        let ahead = history.len() - 1 - at;
+        let first = match known_short {
+            0 => LOOK_AHEAD.min(ahead),
+            _ => known_short + 1,
+        };
+        for look_ahead in first..=ahead {
+            match self.rolled(index, &history[..=at + look_ahead], at) {
+                Ok(rolled) => return Some(rolled),
+                Err(RollThrough::TooShortYet) if look_ahead == ahead => {
+                    if may_wait && ahead < ROLL_REACH_AHEAD {
+                        return None;
+                    }
+                }
+                Err(RollThrough::TooShortYet) => continue,
+                Err(_) => break,
+            }
         }
+        Some(self.fitted(index, &history[..=at + LOOK_AHEAD.min(ahead)], at))
+    }
+
+    /// The point at `at` of `history` (the point is the last window's middle, or its end for a preview) from the
+    /// quartic fit of the last window's centre path in a frame about the point.
+    fn fitted(&self, index: usize, history: &[Sample], at: usize) -> Compensated {
         let window: [Sample; WINDOW] = std::array::from_fn(|i| history[history.len() - WINDOW + i]);
         let at = at + WINDOW - history.len();
         let middle = &window[at];
@@ -413,8 +496,13 @@ impl Compensator {
     }
 
     /// The point at `at` of `history` compensated from a roll round an edge through it, if its centres make one
-    /// (see `roll`): the centre moved back `rho` towards the roll's middle.
-    fn rolled(&self, index: usize, history: &[Sample], at: usize) -> Option<Compensated> {
+    /// (see `roll`): the centre moved back `rho` towards the roll's middle. Else what the centres say of a roll.
+    fn rolled(
+        &self,
+        index: usize,
+        history: &[Sample],
+        at: usize,
+    ) -> Result<Compensated, RollThrough> {
         let w = self.plane_normal.into_inner();
         let u = w
             .cross(&Vector3::x())
@@ -431,10 +519,17 @@ impl Compensator {
                 normal: in_plane(s.normal),
             })
             .collect();
-        let (outward, edge_radius_mm) = roll_through(&samples, at, self.settings.noise_sigma_mm)?;
+        let (outward, edge_radius_mm) =
+            match roll_through(&samples, at, self.settings.noise_sigma_mm) {
+                RollThrough::Roll {
+                    outward,
+                    edge_radius_mm,
+                } => (outward, edge_radius_mm),
+                other => return Err(other),
+            };
         let towards_surface = u * outward.x + v * outward.y;
         let tilt = middle.normal.dot(&w);
-        Some(Compensated {
+        Ok(Compensated {
             index,
             surface: middle.centre - towards_surface * middle.rho,
             normal: towards_surface * (1.0 - tilt * tilt).sqrt() + w * tilt,
@@ -457,7 +552,7 @@ pub fn compensate_path(
     if !closed || points.len() < WINDOW {
         let mut out: Vec<Compensated> = points
             .iter()
-            .filter_map(|(c, n)| compensator.push(*c, *n))
+            .flat_map(|(c, n)| compensator.push(*c, *n))
             .collect();
         out.extend(compensator.finish());
         return out;
@@ -467,15 +562,17 @@ pub fn compensate_path(
         .map(|(c, n)| compensator.sample(*c, *n))
         .collect();
     let count = samples.len();
-    // Each point's history wraps round the closed path, as far back as the streaming one reaches but never onto
-    // its own look-ahead.
-    let back = (HISTORY - 1 - LOOK_AHEAD).min(count - 1 - LOOK_AHEAD);
+    // Each point's history wraps round the closed path, as far back and ahead as the streaming one reaches but
+    // never onto itself.
+    let back = BEHIND.min(count - 1 - LOOK_AHEAD);
+    let ahead = ROLL_REACH_AHEAD.min(count - 1 - back);
     (0..count)
         .map(|i| {
-            let history: Vec<Sample> = (0..=back + LOOK_AHEAD)
+            let history: Vec<Sample> = (0..=back + ahead)
                 .map(|j| samples[(i + count * 2 + j - back) % count])
                 .collect();
-            compensator.fitted(i, &history, back)
+            let compensated = compensator.compensated(i, &history, back, 0, false);
+            compensated.expect("a point that may not wait is compensated")
         })
         .collect()
 }

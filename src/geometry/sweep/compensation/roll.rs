@@ -55,6 +55,10 @@ const MIN_TURN_RAD: f64 = 0.69;
 /// microns.
 const MIN_ROUND_POINTS: usize = 2 * MIN_POINTS - 1;
 
+/// ... and only over a run that turns through at least this much, rad (80 deg, nine centres at a scan's usual
+/// 10 deg steps).
+const MIN_ROUND_TURN_RAD: f64 = 1.39;
+
 /// Gauss-Newton steps of the circle fit, after its algebraic start.
 const FIT_STEPS: usize = 6;
 
@@ -67,25 +71,38 @@ pub(super) struct RollSample {
     pub normal: Vector2<f64>,
 }
 
-/// The roll through the point `at` of `samples` (the point's centres before and up to its look-ahead): the
-/// in-plane unit direction from the roll's middle to the point's centre (the contact is the centre moved back
-/// `rho` along it) and the edge's surface radius, mm. `None` where no run of centres through the point is a roll.
+/// What the centres say of a roll through a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum RollThrough {
+    /// A roll: the in-plane unit direction from its middle to the point's centre (the contact is the centre moved
+    /// back `rho` along it) and the edge's surface radius, mm.
+    Roll {
+        outward: Vector2<f64>,
+        edge_radius_mm: f64,
+    },
+    /// The centres from the point to the newest lie on an edge's circle, but turn less than [`MIN_TURN_RAD`] so
+    /// far: the roll may go on, and the next centres can tell.
+    TooShortYet,
+    /// No run of centres through the point is a roll, nor can later centres make one.
+    None,
+}
+
+/// The roll through the point `at` of `samples` (the point's centres before it and up to the newest).
 ///
 /// The run ends at the latest sample with which the point's centres still lie on one circle, then reaches back
 /// as far as they do.
-pub(super) fn roll_through(
-    samples: &[RollSample],
-    at: usize,
-    noise_sigma_mm: f64,
-) -> Option<(Vector2<f64>, f64)> {
+pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f64) -> RollThrough {
     let tolerance = (MAX_SIGMAS * noise_sigma_mm).max(RESIDUAL_FLOOR_MM);
     let ball = samples[at].rho;
     let edge_circle = |run: &[RollSample]| {
         if !bends_like_an_edge(run, ball) {
             return None;
         }
-        let circle = if run.len() < MIN_ROUND_POINTS {
-            Circle::algebraic(run)?.sharpened(run)?
+        let sharp = Circle::algebraic(run)?.sharpened(run)?;
+        // A round's free radius is no surer than the noise over a short arc, however many centres it has (a roll
+        // in steps of 2 deg over 9 centres read a sharp edge as a 0.1 mm round, and its contacts 10-30 um off).
+        let circle = if run.len() < MIN_ROUND_POINTS || sharp.turn(run).abs() < MIN_ROUND_TURN_RAD {
+            sharp
         } else {
             Circle::fit(run).filter(|c| c.is_edge(ball))?
         };
@@ -104,7 +121,8 @@ pub(super) fn roll_through(
     let on_circle_of = |kind: &Circle, run: &[RollSample], centre: &RollSample| {
         kind.refit(run).is_some_and(|c| predicted(&c, centre))
     };
-    // The run from a core of centres `start..=end`, reaching back as far as its centres lie on its circle.
+    // The run from a core of centres `start..=end`, reaching back as far as its centres lie on its circle: its
+    // length and what it makes of the point.
     let run_from = |mut start: usize, end: usize| {
         let mut circle = edge_circle(&samples[start..=end])?;
         if !on_circle_of(&circle, &samples[start..end], &samples[end])
@@ -119,19 +137,72 @@ pub(super) fn roll_through(
             }
             start -= 1;
         }
-        let roll = circle.roll_at(&samples[start..=end], at - start)?;
-        Some((end - start, roll))
+        Some((
+            end - start,
+            circle.roll_at(&samples[start..=end], at - start)??,
+        ))
     };
     // The latest end first; from the fewest centres that can show a sharp edge, and from the fewest that can show
     // a round one, the longer run (a round's first centres fit a sharp edge's circle too, but their run stops
     // where the round's goes on).
-    (at..samples.len()).rev().find_map(|end| {
+    let roll = (at..samples.len()).rev().find_map(|end| {
         [MIN_POINTS, MIN_ROUND_POINTS]
             .into_iter()
             .filter_map(|points| run_from((end + 1).checked_sub(points)?.min(at), end))
             .max_by_key(|(length, _)| *length)
             .map(|(_, roll)| roll)
-    })
+    });
+    if let Some((outward, edge_radius_mm)) = roll {
+        RollThrough::Roll {
+            outward,
+            edge_radius_mm,
+        }
+    } else if roll_may_follow(samples, at, tolerance) {
+        RollThrough::TooShortYet
+    } else {
+        RollThrough::None
+    }
+}
+
+/// Centres behind a point that show the path bending where a roll may start: the quartic's half window.
+const BENDING_BEHIND: usize = 4;
+
+/// Whether a roll may be starting at the point `at`: the centres from it to the newest lie on a sharp edge's
+/// circle, convex and turning less than [`MIN_TURN_RAD`] so far, and the centres after it leave the line of the
+/// few before it (so they are not a finely scanned face's, which any circle as wide as the ball fits over a short
+/// stretch). In steps of a few degrees, the first centres of a roll are too
+/// close together for [`bends_like_an_edge`] to see their circle.
+fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
+    let run = &samples[at..];
+    if run.len() < 3 {
+        return false;
+    }
+    let Some(circle) = Circle::algebraic(run).and_then(|c| c.sharpened(run)) else {
+        return false;
+    };
+    let behind = &samples[at.saturating_sub(BENDING_BEHIND)..=at];
+    circle.holds(run, tolerance)
+        && circle.roll_at(run, 0) == Some(None)
+        && behind.len() > 2
+        && leaves_the_line(behind, &samples[at + 1..], tolerance)
+}
+
+/// Whether any of the centres `ahead` lies farther than `tolerance` from the least-squares line of the centres
+/// `behind` (through their mean, along their principal direction).
+fn leaves_the_line(behind: &[RollSample], ahead: &[RollSample], tolerance: f64) -> bool {
+    let mean = behind.iter().map(|s| s.centre).sum::<Vector2<f64>>() / behind.len() as f64;
+    let scatter = behind.iter().fold(Matrix2::zeros(), |m, s| {
+        let d = s.centre - mean;
+        m + d * d.transpose()
+    });
+    let eigen = scatter.symmetric_eigen();
+    let across = eigen
+        .eigenvectors
+        .column(eigen.eigenvalues.imin())
+        .into_owned();
+    ahead
+        .iter()
+        .any(|s| (s.centre - mean).dot(&across).abs() > tolerance)
 }
 
 /// Whether the circle through a run's first, middle and last centres is anywhere near an edge's for a ball of
@@ -263,21 +334,28 @@ impl Circle {
         self.surface_radius.abs() <= MAX_EDGE_RADIUS * ball
     }
 
-    /// The roll's answer for the run's sample `at`, if the run is a roll: the circle's middle on the material
-    /// side of every centre (a convex edge, as every reported normal says), the run turning through
-    /// [`MIN_TURN_RAD`].
-    fn roll_at(&self, run: &[RollSample], at: usize) -> Option<(Vector2<f64>, f64)> {
+    /// The roll's answer for the run's sample `at`, if the run is a convex edge's (the circle's middle on the
+    /// material side of every centre, as every reported normal says): `Some(None)` while the run turns through
+    /// less than [`MIN_TURN_RAD`], else the point's outward direction and the edge's surface radius.
+    fn roll_at(&self, run: &[RollSample], at: usize) -> Option<Option<(Vector2<f64>, f64)>> {
         let outward = |s: &RollSample| (s.centre - self.middle).normalize();
         if !run.iter().all(|s| outward(s).dot(&s.normal) > 0.0) {
             return None;
         }
-        let turn: f64 = run
-            .windows(2)
+        Some(
+            (self.turn(run).abs() >= MIN_TURN_RAD)
+                .then(|| (outward(&run[at]), self.surface_radius)),
+        )
+    }
+
+    /// How far the run turns about the circle's middle, from its first centre to its last, rad (signed).
+    fn turn(&self, run: &[RollSample]) -> f64 {
+        let outward = |s: &RollSample| (s.centre - self.middle).normalize();
+        run.windows(2)
             .map(|pair| {
                 let (from, to) = (outward(&pair[0]), outward(&pair[1]));
                 from.perp(&to).atan2(from.dot(&to))
             })
-            .sum();
-        (turn.abs() >= MIN_TURN_RAD).then(|| (outward(&run[at]), self.surface_radius))
+            .sum()
     }
 }
