@@ -425,8 +425,17 @@ impl<'a> Across<'a> {
             if sp == sq || (sp > 0.0) == (sq > 0.0) && sp != 0.0 && sq != 0.0 {
                 continue;
             }
-            let t = sp / (sp - sq);
-            let offset = (p + (q - p) * t).dot(&self.normal);
+            // Where the smooth outline through the points crosses the line, between these two of them: the
+            // chord between points a scan takes 10 deg apart round a 2.5 mm nose cuts 9.5 um inside it, which put
+            // the leading-edge thickness 2 mm in 14-24 um thin on every blade (the dense nominal has no such cut).
+            let crossing = match CatmullRom::through(self.outline, i) {
+                Some(segment) => {
+                    let along = |t: f64| (segment.at(t) - self.origin).dot(&self.along) - s;
+                    segment.at(bisect(along, sp, sq)) - self.origin
+                }
+                None => p + (q - p) * (sp / (sp - sq)),
+            };
+            let offset = crossing.dot(&self.normal);
             low = low.min(offset);
             high = high.max(offset);
         }
@@ -455,6 +464,71 @@ impl<'a> Across<'a> {
         }));
         Ok((centre, distance_to_outline(self.outline, &centre)))
     }
+}
+
+/// The segment from point `i` of a closed outline to the next of the centripetal Catmull-Rom curve through the
+/// points (Barry and Goldman's evaluation): a cubic through the two and their neighbours either side that follows
+/// a circle sampled every 10 deg to 0.05 um, and does not overshoot where the spacing changes (the centripetal
+/// parametrisation). Written here: the spline crates on crates.io are for animation curves, not for a closed
+/// outline's segment-by-segment intersections.
+struct CatmullRom {
+    points: [Vector2<f64>; 4],
+    knots: [f64; 4],
+}
+
+impl CatmullRom {
+    /// `None` where two of the four points coincide (a sharp edge's contacts can), which leaves the chord.
+    fn through(outline: &[Vector2<f64>], i: usize) -> Option<Self> {
+        let n = outline.len();
+        let points = [0, 1, 2, 3].map(|k| outline[(i + n + k - 1) % n]);
+        let mut knots = [0.0; 4];
+        for k in 1..4 {
+            let step = (points[k] - points[k - 1]).norm().sqrt();
+            if step < 1e-6 {
+                return None;
+            }
+            knots[k] = knots[k - 1] + step;
+        }
+        Some(CatmullRom { points, knots })
+    }
+
+    /// The point at `t` in [0, 1], from point `i` (t = 0) to the next (t = 1).
+    fn at(&self, t: f64) -> Vector2<f64> {
+        let [p0, p1, p2, p3] = self.points;
+        let [t0, t1, t2, t3] = self.knots;
+        let u = t1 + (t2 - t1) * t;
+        let blend = |a: Vector2<f64>, b: Vector2<f64>, from: f64, to: f64| {
+            a * ((to - u) / (to - from)) + b * ((u - from) / (to - from))
+        };
+        let (a1, a2, a3) = (
+            blend(p0, p1, t0, t1),
+            blend(p1, p2, t1, t2),
+            blend(p2, p3, t2, t3),
+        );
+        blend(blend(a1, a2, t0, t2), blend(a2, a3, t1, t3), t1, t2)
+    }
+}
+
+/// The root in [0, 1] of `f`, which is `f0` at 0 and `f1` at 1, of opposite signs (or one of them zero), by
+/// bisection.
+fn bisect(f: impl Fn(f64) -> f64, f0: f64, f1: f64) -> f64 {
+    if f0 == 0.0 {
+        return 0.0;
+    }
+    if f1 == 0.0 {
+        return 1.0;
+    }
+    let (mut low, mut high) = (0.0, 1.0);
+    let rising = f1 > f0;
+    for _ in 0..50 {
+        let middle = (low + high) / 2.0;
+        if (f(middle) < 0.0) == rising {
+            low = middle;
+        } else {
+            high = middle;
+        }
+    }
+    (low + high) / 2.0
 }
 
 /// The distance from `p` to the closed polyline `outline`.

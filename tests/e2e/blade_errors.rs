@@ -88,9 +88,11 @@ pub fn assert_parameters_read_the_injected_errors(
             // nose, 31 um before the sharp trailing edge's roll was compensated from its circle), and within 9.7 um
             // on propeller.toml since a roll's first points wait for the roll (25 um before on blade B, whose
             // sections turned by its pitch error are rolled round in steps of 2-5 deg; BENCHMARKS.md, "The chord").
-            // The chord is held to 12 um, not the 5. The leading-edge thickness reads within 24 um against
-            // the faces' nose as against the polynomial's, so its error is not the nominal's; its cause is not yet
-            // found, and it is held to 30 um.
+            // The chord is held to 12 um, not the 5. The leading-edge thickness 2 mm in read 14-24 um thin
+            // on every blade, A included, while the faces were crossed along the chords between the scan's points
+            // (up to 1 mm apart round the nose); along the smooth outline through them it reads within 9.3 um on
+            // propeller.toml and 14.5 um on the shape errors (C r200, whose camber +2.6 % also turns the nose), and is
+            // held to 20 um.
             let checks = [
                 (
                     "max thickness",
@@ -132,7 +134,7 @@ pub fn assert_parameters_read_the_injected_errors(
                     "leading-edge thickness",
                     p.le_thickness_mm.deviation,
                     edge(p.le_thickness_mm.nominal),
-                    0.03,
+                    0.02,
                 ),
             ];
             for (name, deviation, expected, limit) in checks {
