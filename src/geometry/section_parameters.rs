@@ -11,9 +11,10 @@
 //!
 //! Definitions (each measured the same way on the scanned section and on the nominal, so that their differences
 //! are the errors):
-//! - The nose and tail are the two outline points farthest apart, each moved out along the chord by how far it
-//!   lies behind the tip of its edge's circle where the edge is round (see the edge radius below: a scan's points
-//!   step round a nose, and the farthest of them misses its tip by a few microns); the chord joins them. The leading edge is the blunter end: the one
+//! - The nose and tail are the two outline points farthest apart, each moved out along the chord, where the edge
+//!   is round (see the edge radius below), to the farthest reach of the smooth outline through the points beside
+//!   it (a scan's points step round a nose, and the farthest of them misses its tip by a few microns); the chord
+//!   joins them. Between its points the outline is the centripetal Catmull-Rom curve through them. The leading edge is the blunter end: the one
 //!   whose section is thicker at `EDGE_PROBE` of the chord in from it (an airfoil's round nose against its thin
 //!   tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
@@ -161,19 +162,18 @@ pub(crate) fn section_parameters(
     };
     // A round end's tip lies beyond its farthest point: the outline's points step round a nose by several
     // degrees (10 at the simulated scan's nose), so the farthest of them falls short of the tip by r (1 - cos a),
-    // a its angle from the tip about the nose's centre: up to 5 um on a 2.5 mm nose, differently on every scan.
-    // The edge's circle gives that shortfall; the end is moved out along the chord by it, so that a dense outline
-    // (a nominal's) keeps its own tip whatever the circle's fit to the nose's shape. The edge thicknesses are taken
-    // from the moved ends.
+    // a its angle from the tip: up to 5 um on a 2.5 mm nose, differently on every scan. The end is moved out along
+    // the chord to the smooth outline's farthest reach beside it. (From the edge's circle instead, the shortfall
+    // came out 6 um too long on a cambered nose: the circle fitted over 83 deg of a nose whose curvature differs
+    // on its two faces has its centre off to one side, which makes every point seem off the tip.) A dense outline
+    // (a nominal's) keeps its own tip. The edge thicknesses are taken from the moved ends.
     let inward = (trailing_edge - leading_edge).normalize();
     let zone_mm = edge_distance_mm / 2.0;
     let le_circle = edge_circle(outline, leading_edge, inward, zone_mm);
     let te_circle = edge_circle(outline, trailing_edge, -inward, zone_mm);
-    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| {
-        circle.map_or(end, |c| {
-            let cos_off_tip = (end - c.centre).normalize().dot(&outward);
-            end + outward * (c.radius * (1.0 - cos_off_tip))
-        })
+    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| match circle {
+        Some(_) => end + outward * smooth_reach_beyond(outline, end, outward),
+        None => end,
     };
     let leading_edge = to_tip(leading_edge, le_circle, -inward);
     let trailing_edge = to_tip(trailing_edge, te_circle, inward);
@@ -507,6 +507,23 @@ impl CatmullRom {
         );
         blend(blend(a1, a2, t0, t2), blend(a2, a3, t1, t3), t1, t2)
     }
+}
+
+/// How far beyond the outline point `end` the smooth outline through the points reaches along `outward`, on the
+/// segments either side of it (mm, at least 0).
+fn smooth_reach_beyond(outline: &[Vector2<f64>], end: Vector2<f64>, outward: Vector2<f64>) -> f64 {
+    let Some(k) = outline.iter().position(|p| *p == end) else {
+        return 0.0;
+    };
+    let n = outline.len();
+    [(k + n - 1) % n, k]
+        .into_iter()
+        .filter_map(|i| CatmullRom::through(outline, i))
+        .map(|segment| {
+            let reach = |t: f64| (segment.at(t) - end).dot(&outward);
+            reach(golden_max(0.0, 1.0, reach))
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The root in [0, 1] of `f`, which is `f0` at 0 and `f1` at 1, of opposite signs (or one of them zero), by
