@@ -56,9 +56,9 @@
 //! look-ahead, instead of the quartic (see `roll` for why the quartic fails there).
 //!
 //! Streaming: a point is compensated once the K = 4 points after it have arrived (the first points of a roll that
-//! starts in small steps wait longer, until the roll shows where its edge is: see [`ROLL_REACH_AHEAD`]). The first and last K points of an
-//! open path have no symmetric window and use the reported normal, as do points where the fit cannot work. Until
-//! then a point has a provisional compensation, from the window that ends at it ([`Compensator::preview`]): a
+//! starts in small steps wait longer, until the roll shows where its edge is: see [`ROLL_REACH_AHEAD`]). The first
+//! and last K points of an open path have no symmetric window and use the reported normal, as do points where the
+//! fit cannot work. Until then a point has a provisional compensation, from the window that ends at it ([`Compensator::preview`]): a
 //! machine sends its points in lines of several, so the last K of a line would otherwise wait a whole line for
 //! their look-ahead, and the live deviation with them.
 

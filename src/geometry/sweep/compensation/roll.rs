@@ -13,12 +13,13 @@
 //! A circle has three parameters and describes the roll exactly, whatever the edge's radius (a sharp edge's centre
 //! path is a circle of the ball's radius about the apex; a round of radius R gives one of radius R + r about its
 //! middle). So where the centres round the point being compensated lie on one circle within the noise, over a run
-//! that may reach back beyond the quartic's window but not ahead of its look-ahead, and that circle is an edge's
-//! (its surface radius at most [`MAX_EDGE_RADIUS`] of the ball's), the contact is taken from it: the centre moved
-//! towards the circle's middle by the ball's radius. A face's centres leave the circle by the square of their
-//! distance from the roll, so only a face's point within a tenth of a millimetre or so of the roll's end can be
-//! taken as the roll's (its contact then moves along the face towards the edge, and off it by no more than the
-//! noise allows).
+//! that may reach back beyond the quartic's window but not ahead of the centres come so far, and that circle is an
+//! edge's (its surface radius at most [`MAX_EDGE_RADIUS`] of the ball's), the contact is taken from it: the centre
+//! moved towards the circle's middle by the ball's radius. Where the centres from the point on lie on a sharp
+//! edge's circle but have not turned far enough yet to place it ([`RollThrough::TooShortYet`]), the compensator
+//! waits for more. A face's centres leave the circle by the square of their distance from the roll, so only a
+//! face's point within a tenth of a millimetre or so of the roll's end can be taken as the roll's (its contact
+//! then moves along the face towards the edge, and off it by no more than the noise allows).
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
@@ -170,8 +171,8 @@ const BENDING_BEHIND: usize = 4;
 /// Whether a roll may be starting at the point `at`: the centres from it to the newest lie on a sharp edge's
 /// circle, convex and turning less than [`MIN_TURN_RAD`] so far, and the centres after it leave the line of the
 /// few before it (so they are not a finely scanned face's, which any circle as wide as the ball fits over a short
-/// stretch). In steps of a few degrees, the first centres of a roll are too
-/// close together for [`bends_like_an_edge`] to see their circle.
+/// stretch). In steps of a few degrees, the first centres of a roll are too close together for
+/// [`bends_like_an_edge`] to see their circle.
 fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
     let run = &samples[at..];
     if run.len() < 3 {
