@@ -169,11 +169,14 @@ impl Pipeline {
                     profile.waiting.push_back(received_us);
                     let _ = recorder.send(Record::Point { key, raw }).await;
                     let centre = Point3::from(raw.centre);
-                    for point in profile.compensator.push(centre, Vector3::from(raw.normal)) {
-                        self.publish(key, profile, point);
-                    }
+                    // The newest point's preview first: a roll's first points may come out of the compensator
+                    // together once the roll shows its edge, and the live deviation must not wait for them.
+                    let released = profile.compensator.push(centre, Vector3::from(raw.normal));
                     if let Some(preview) = profile.compensator.preview() {
                         self.publish_preview(key, profile, preview, received_us);
+                    }
+                    for point in released {
+                        self.publish(key, profile, point);
                     }
                 }
                 PipelineMsg::End { key } => {
