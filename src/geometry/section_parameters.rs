@@ -11,12 +11,12 @@
 //!
 //! Definitions (each measured the same way on the scanned section and on the nominal, so that their differences
 //! are the errors):
+//! - Between its points the outline is the centripetal Catmull-Rom curve through them.
 //! - The nose and tail are the two outline points farthest apart, each moved out along the chord, where the edge
-//!   is round (see the edge radius below), to the farthest reach of the smooth outline through the points beside
-//!   it (a scan's points step round a nose, and the farthest of them misses its tip by a few microns); the chord
-//!   joins them. Between its points the outline is the centripetal Catmull-Rom curve through them. The leading edge is the blunter end: the one
-//!   whose section is thicker at `EDGE_PROBE` of the chord in from it (an airfoil's round nose against its thin
-//!   tail).
+//!   is round (see the edge radius below), to the farthest reach of the smooth outline beside it (a scan's points
+//!   step round a nose, and the farthest of them misses its tip by a few microns); the chord joins them. The
+//!   leading edge is the blunter end: the one whose section is thicker at `EDGE_PROBE` of the chord in from it (an
+//!   airfoil's round nose against its thin tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
 //!   to the chord meets the outline on both faces; the section's thickness there is the length between them.
 //! - The maximum thickness: the diameter of the largest circle inside the outline, found as the largest of the
@@ -171,12 +171,15 @@ pub(crate) fn section_parameters(
     let zone_mm = edge_distance_mm / 2.0;
     let le_circle = edge_circle(outline, leading_edge, inward, zone_mm);
     let te_circle = edge_circle(outline, trailing_edge, -inward, zone_mm);
-    let to_tip = |end: Vector2<f64>, circle: Option<Circle>, outward: Vector2<f64>| match circle {
-        Some(_) => end + outward * smooth_reach_beyond(outline, end, outward),
-        None => end,
+    let to_tip = |end: Vector2<f64>, round: bool, outward: Vector2<f64>| {
+        if round {
+            end + outward * smooth_reach_beyond(outline, end, outward)
+        } else {
+            end
+        }
     };
-    let leading_edge = to_tip(leading_edge, le_circle, -inward);
-    let trailing_edge = to_tip(trailing_edge, te_circle, inward);
+    let leading_edge = to_tip(leading_edge, le_circle.is_some(), -inward);
+    let trailing_edge = to_tip(trailing_edge, te_circle.is_some(), inward);
     let chord_mm = (trailing_edge - leading_edge).norm();
     let across = Across::new(outline, leading_edge, trailing_edge);
     let le_thickness_mm = across.thickness_at(edge_distance_mm)?;

@@ -85,7 +85,7 @@ pub(super) enum RollThrough {
     /// far: the roll may go on, and the next centres can tell.
     TooShortYet,
     /// No run of centres through the point is a roll, nor can later centres make one.
-    None,
+    NotARoll,
 }
 
 /// The roll through the point `at` of `samples` (the point's centres before it and up to the newest).
@@ -161,7 +161,7 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
     } else if roll_may_follow(samples, at, tolerance) {
         RollThrough::TooShortYet
     } else {
-        RollThrough::None
+        RollThrough::NotARoll
     }
 }
 
