@@ -41,7 +41,8 @@
 //! 0.34 sigma / h (a parabola's 0.13 sigma / h), which moves the contact along the surface by `r` times that but
 //! off it only by `r` times its square over two. Nine points leave four degrees of freedom, so the fit's residual
 //! tells a window the quartic cannot follow (a corner, sampling too coarse for the curvature) from noise. Such a window, bending convexly, falls back to the reported normal (sound there: the
-//! ball rolls round an edge and the machine's normal points at it); bending concavely, it is flagged as a cusp.
+//! ball rolls round an edge and the machine's normal points at it); bending concavely, and turning so from its
+//! first centre to its last, it is flagged as a cusp.
 //!
 //! The tilt (3-D case): a section scan keeps the ball centre in the plane, but where the surface leans along the
 //! plane's normal `w` the contact lies `r n.w` out of the plane. The out-of-plane component comes from the
@@ -455,7 +456,21 @@ impl Compensator {
         let residual_limit =
             (RESIDUAL_SIGMAS * self.settings.noise_sigma_mm).max(RESIDUAL_FLOOR_MM);
         if fit.residual_mm > residual_limit {
-            let method = if path_curvature > 0.0 {
+            // Flagged only if the window also turns concavely as a whole, from its first centre over its middle
+            // to its last: a convex roll's end meeting a face (the path's curvature jumping from 1/rho to 0) defeats
+            // the quartic too, and its fit may bend either way at the point; the face's contacts next to a trailing
+            // edge's roll were flagged so and left out of the statistics.
+            let (first, middle_of_window, last) = (0, WINDOW / 2, WINDOW - 1);
+            let (ax, ay) = (
+                xs[middle_of_window] - xs[first],
+                ys[middle_of_window] - ys[first],
+            );
+            let (bx, by) = (
+                xs[last] - xs[middle_of_window],
+                ys[last] - ys[middle_of_window],
+            );
+            let turns_concavely = side * (ax * by - ay * bx) > 0.0;
+            let method = if path_curvature > 0.0 && turns_concavely {
                 Method::Flagged(Cusp::UnresolvedConcave {
                     residual_mm: fit.residual_mm,
                 })

@@ -694,6 +694,7 @@ fn a_sharp_edge_scanned_at_a_scans_steps_puts_every_contact_of_the_roll_on_the_e
     // ends); from the roll's circle they are within 11 um. A face's contact next to the roll may be taken from the
     // circle: along the face it moves towards the edge, but off it by no more than the noise allows (the circle
     // takes a centre in within 6 sigma, 12 um; 10.7 um here since a roll's first points wait for it, 7.1 before).
+    // No point is flagged.
     let mut rng = StdRng::seed_from_u64(11);
     let (mut worst_roll, mut worst_face) = (0.0f64, 0.0f64);
     let mut rolled = 0;
@@ -702,6 +703,10 @@ fn a_sharp_edge_scanned_at_a_scans_steps_puts_every_contact_of_the_roll_on_the_e
         let truth = sharp_edge(half_angle, 0.5 + rng.gen::<f64>(), rng.gen());
         let path = with_noise(scan(&truth, 1.0, 0.0), 0.002, &mut rng);
         let out = compensate_path(CompensationSettings::new(1.0), Vector3::z(), &path, false);
+        // Nothing on a convex wedge is a cusp: the faces' points next to the roll, whose windows the quartic
+        // cannot follow, were flagged as concave ones (15 of these 40 wedges), and left out of the statistics.
+        let flagged: Vec<_> = out.iter().filter(|c| c.is_flagged()).collect();
+        assert!(flagged.is_empty(), "{flagged:?}");
         for c in &out[LOOK_AHEAD..out.len() - LOOK_AHEAD] {
             let (x, n) = truth[c.index];
             let error = c.surface - at(x, 0.0);
