@@ -363,3 +363,56 @@ fn a_nose_scanned_in_10_degree_steps_keeps_its_tip_whatever_the_steps_phase() {
         "the steps cost the farthest points only {worst_shortfall} mm"
     );
 }
+
+/// `dense` (from its sharp tail round, closed) as a scan steps round it: the tail, then a point every `step` mm
+/// along the outline (from `phase` of a step on) or where its direction has turned another 10 deg, whichever
+/// comes first.
+fn stepped(dense: &[Vector2<f64>], step: f64, phase: f64) -> Vec<Vector2<f64>> {
+    let direction = |i: usize| {
+        let t = dense[(i + 1) % dense.len()] - dense[i];
+        t.y.atan2(t.x)
+    };
+    let mut out = vec![dense[0]];
+    let (mut travelled, mut last_angle) = ((1.0 - phase) * step, direction(1));
+    for i in 1..dense.len() {
+        travelled += (dense[i] - dense[i - 1]).norm();
+        let turned = (direction(i) - last_angle + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        if travelled >= step || turned.abs() >= 10f64.to_radians() {
+            out.push(dense[i]);
+            travelled = 0.0;
+            last_angle = direction(i);
+        }
+    }
+    out
+}
+
+#[test]
+fn a_noisy_scans_maximum_thickness_is_not_read_at_its_luckiest_station() {
+    // NACA 4412 and 6409 at 150 mm chord scanned as the simulated CMM steps (0.75-1.25 mm along the faces, 10 deg
+    // round the nose), 2 um noise, 20 draws each: the maximum thickness within 4 um of the dense outline's (3.1 um
+    // at worst here), never biased by more than a micron. Before, the largest of the stations' noisy inscribed
+    // circles (against the points' chords) was taken: up to 7.9 um thick over 40 draws.
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(41);
+    for digits in ["4412", "6409"] {
+        let dense: Vec<Vector2<f64>> = Naca4::from_digits(digits, 150.0, true)
+            .unwrap()
+            .points(30000)
+            .into_iter()
+            .map(|[x, y]| Vector2::new(x, y))
+            .collect();
+        let truth = section_parameters(&dense, 2.0).unwrap().max_thickness_mm;
+        let errors: Vec<f64> = (0..20)
+            .map(|draw| {
+                let scan = stepped(&dense, 0.75 + 0.5 * rng.gen::<f64>(), rng.gen());
+                let outline = noisy(&scan, 0.002, draw);
+                section_parameters(&outline, 2.0).unwrap().max_thickness_mm - truth
+            })
+            .collect();
+        let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+        let worst = errors.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        assert!(worst < 0.004, "NACA {digits}: {errors:?}");
+        assert!(mean.abs() < 0.001, "NACA {digits}: mean {mean}");
+    }
+}
