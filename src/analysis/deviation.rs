@@ -11,7 +11,7 @@ use std::sync::{Arc, OnceLock};
 use nalgebra::{Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
-use super::edges::SharpEdge;
+use super::edges::{sharpen, SharpEdge};
 use super::reference::Reference;
 use super::section;
 use crate::geometry::distance::{DistanceError, ExactDistance, Foot};
@@ -136,9 +136,18 @@ impl ProfileGauge {
         self.parameters
             .get_or_init(|| match &self.model {
                 GaugeModel::Ip {
-                    faces: Some(faces), ..
-                } => section_parameters(&section::faces_outline(faces), section::EDGE_DISTANCE_MM)
-                    .map_err(|e| format!("its nominal: {e}")),
+                    faces: Some(faces),
+                    edges,
+                    ..
+                } => section_parameters(
+                    // At the master's sharp edges the apex is the mean of its roll's contacts, as a scan's tip is
+                    // (`section_parameters`): the faces' crossing, an extrapolation along a wedge of a few
+                    // degrees, put the simulated propeller's nominal trailing edges 2-3 um off along the chord.
+                    &sharpen(&section::faces_outline(faces), edges),
+                    &[],
+                    section::EDGE_DISTANCE_MM,
+                )
+                .map_err(|e| format!("its nominal: {e}")),
                 GaugeModel::Ip {
                     model,
                     nominals,

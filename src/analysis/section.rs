@@ -3,7 +3,7 @@
 //! form error once that is removed, by least squares and by minimum zone; and its parameters (chord, thicknesses,
 //! camber, chord angle, pitch) measured beside the nominal's.
 
-use nalgebra::{Point3, Vector2};
+use nalgebra::{Isometry3, Point3, Vector2};
 use serde::{Deserialize, Serialize};
 
 use super::deviation::ProfileGauge;
@@ -14,6 +14,7 @@ use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::project_to_zero_set;
 use crate::geometry::section_fit::{fit_section, FitLimits, FitMethod, FitMode, Form, Measured};
 use crate::geometry::section_parameters::{farthest_pair, section_parameters, SectionParameters};
+use crate::geometry::sweep::compensation::Compensated;
 use crate::geometry::trace::simplify_closed;
 
 /// The spacing of a nominal outline's points before it is thinned, mm: fine enough that its sampling moves the
@@ -345,6 +346,7 @@ pub(crate) fn nominal_parameters(
 ) -> Result<SectionParameters, String> {
     section_parameters(
         &sharpen(&nominal_outline(model, nominals), edges),
+        &[],
         EDGE_DISTANCE_MM,
     )
     .map_err(|e| format!("its nominal: {e}"))
@@ -507,15 +509,42 @@ pub struct SectionShape {
     pub distribution: SectionDistribution,
 }
 
-/// The parameters of the section scanned as `points` (part frame, in scan order round it, flagged contacts left
-/// out) beside `nominal`'s; `radius_mm` is the section's radius about a propeller's hub axis, if it is one.
+/// A scanned section as its evaluation takes it: the compensated points not flagged, in the part's frame and in
+/// scan order round the section, and which of them are contacts of the ball rolling round a sharp edge.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ScannedSection {
+    pub points: Vec<Point3<f64>>,
+    /// Indices into `points` of the contacts [`Compensated::is_on_a_sharp_edge`] names.
+    pub sharp_edge_contacts: Vec<usize>,
+}
+
+impl ScannedSection {
+    /// Takes the next compensated point (machine frame), unless it is flagged.
+    pub fn push(&mut self, point: &Compensated, machine_to_part: &Isometry3<f64>) {
+        if point.is_flagged() {
+            return;
+        }
+        if point.is_on_a_sharp_edge() {
+            self.sharp_edge_contacts.push(self.points.len());
+        }
+        self.points.push(machine_to_part * point.surface);
+    }
+}
+
+/// The parameters of the scanned `section` beside `nominal`'s; `radius_mm` is the section's radius about a
+/// propeller's hub axis, if it is one.
 pub fn parameters(
     nominal: &SectionParameters,
-    points: &[Point3<f64>],
+    section: &ScannedSection,
     radius_mm: Option<f64>,
 ) -> Result<SectionShape, String> {
-    let in_plane: Vec<Vector2<f64>> = points.iter().map(|p| Vector2::new(p.y, p.z)).collect();
-    let measured = section_parameters(&in_plane, EDGE_DISTANCE_MM).map_err(|e| e.to_string())?;
+    let in_plane: Vec<Vector2<f64>> = section
+        .points
+        .iter()
+        .map(|p| Vector2::new(p.y, p.z))
+        .collect();
+    let measured = section_parameters(&in_plane, &section.sharp_edge_contacts, EDGE_DISTANCE_MM)
+        .map_err(|e| e.to_string())?;
     let value =
         |read: fn(&SectionParameters) -> f64| ParameterValue::of(read(nominal), read(&measured));
     let radius = |read: fn(&SectionParameters) -> Option<f64>| {

@@ -124,12 +124,12 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         pivot.y
     );
     print_fit(&fitted, &chord, &settings.limits());
-    let measured = section_parameters(&points, args.edge_distance)
+    let measured = section_parameters(&points, &[], args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     let nominal = nominal
         .outline(&points)
         .and_then(|outline| {
-            section_parameters(&outline, args.edge_distance).map_err(|e| e.to_string())
+            section_parameters(&outline, &[], args.edge_distance).map_err(|e| e.to_string())
         })
         .map_err(|e| anyhow!("{}: {e}", args.model.display()));
     print_parameters(&measured, nominal, args.edge_distance);

@@ -14,6 +14,7 @@ use super::verdicts::judge_blades;
 use crate::analysis::compensate_scan;
 use crate::analysis::deviation::ProfileGauge;
 use crate::analysis::reference::{teach, MasterProfile, Reference};
+use crate::analysis::section::ScannedSection;
 use crate::analysis::stats::{RunningStats, Tolerance, Verdict};
 use crate::analysis::tolerances::failures;
 use crate::analysis::{fit_sanity, section};
@@ -207,12 +208,10 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
             let compensated =
                 compensate_scan(&scan.points, radius, plan.plane_normal(key.instance));
             let mut flagged = 0;
-            let mut in_part = Vec::with_capacity(scan.points.len());
+            let mut in_part = ScannedSection::default();
             for (raw, point) in scan.points.iter().zip(&compensated) {
                 let surface = point.surface;
-                if !point.is_flagged() {
-                    in_part.push(to_part * surface);
-                }
+                in_part.push(point, &to_part);
                 let measured = gauge.measure(&(to_part * surface)).map_err(|e| {
                     format!(
                         "{} ({}): a point at ({:.3}, {:.3}, {:.3}) mm has no deviation: {e}",
@@ -256,7 +255,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                 .ok_or_else(|| format!("{}: the scan has no points", plan.describe(key)))?;
             let best_fits = match section::best_fits(
                 &inputs.gauges[key.profile],
-                &in_part,
+                &in_part.points,
                 plan.best_fit(),
             ) {
                 Ok(fitted) => {

@@ -22,7 +22,7 @@ use super::journal::{JobDir, ScanHeader};
 use super::recorder::{Record, Recorder};
 use super::DaemonMsg;
 use crate::analysis::deviation::{ProfileGauge, ScanGauge};
-use crate::analysis::section;
+use crate::analysis::section::{self, ScannedSection};
 use crate::analysis::stats::{RunningStats, Tolerance};
 use crate::analysis::RawPoint;
 use crate::api::{Event, ScanRef};
@@ -82,7 +82,7 @@ struct Active<'g> {
     flagged: usize,
     /// The compensated points not flagged, part frame, in scan order: the section evaluated at the scan's end
     /// (inspect only; a teach scan keeps none).
-    in_part: Vec<Point3<f64>>,
+    in_part: ScannedSection,
 }
 
 impl Pipeline {
@@ -153,7 +153,7 @@ impl Pipeline {
                             stats: RunningStats::default(),
                             outside: 0,
                             flagged: 0,
-                            in_part: Vec::new(),
+                            in_part: ScannedSection::default(),
                         },
                     );
                 }
@@ -242,7 +242,7 @@ impl Pipeline {
         let described = self.plan.describe(key);
         tokio::task::spawn_blocking(move || {
             let gauge = &gauges[key.profile];
-            let best_fits = section::best_fits(gauge, &in_part, &fit_settings)
+            let best_fits = section::best_fits(gauge, &in_part.points, &fit_settings)
                 .map(|f| f.fits)
                 .unwrap_or_else(|problem| {
                     tracing::warn!(scan = %described, %problem, "live: no best fit of the section");
@@ -331,7 +331,7 @@ impl Pipeline {
         if point.is_flagged() {
             profile.flagged += 1;
         } else if profile.gauge.is_some() {
-            profile.in_part.push(profile.machine_to_part * surface);
+            profile.in_part.push(&point, &profile.machine_to_part);
         }
         if let (Some(d), false) = (deviation, point.is_flagged()) {
             profile.stats.push(d, surface.coords.into());

@@ -101,6 +101,10 @@ const RESIDUAL_FLOOR_MM: f64 = 1e-4;
 /// an honest window exceeds it with probability 3e-7 (chi-square, 36 > 4 degrees).
 const RESIDUAL_SIGMAS: f64 = 3.0;
 
+/// A roll's edge whose radius is under this is sharp: its contacts, spread over its round, are all within this of
+/// its apex (a sharp edge's circle has radius 0, one fitted with its radius reads 0 within a few microns).
+const SHARP_EDGE_RADIUS_MM: f64 = 0.005;
+
 /// A reported normal whose part in the section plane is shorter than this cannot orient the path's normal (the
 /// surface lies nearly in the section plane, which a section scan cannot follow).
 const MIN_IN_PLANE: f64 = 0.1;
@@ -192,6 +196,12 @@ impl Compensated {
     /// Whether the point's contact is flagged as not to be trusted (keep it, leave it out of statistics).
     pub fn is_flagged(&self) -> bool {
         matches!(self.method, Method::Flagged(_))
+    }
+
+    /// Whether the point is a contact of the ball rolling round a sharp edge (its radius under
+    /// [`SHARP_EDGE_RADIUS_MM`]): one of several estimates of the edge's apex.
+    pub fn is_on_a_sharp_edge(&self) -> bool {
+        matches!(self.method, Method::Roll { edge_radius_mm } if edge_radius_mm.abs() < SHARP_EDGE_RADIUS_MM)
     }
 }
 
