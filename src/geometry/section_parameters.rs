@@ -20,9 +20,10 @@
 //!   airfoil's round nose against its thin tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
 //!   to the chord meets the outline on both faces; the section's thickness there is the length between them.
-//! - The maximum thickness: the diameter of the largest circle inside the outline, found as the largest of the
-//!   circles centred on each station's line (every inside point lies on one station's line), refined about the
-//!   best station.
+//! - The maximum thickness: the diameter of the largest circle inside the outline, found among the circles
+//!   centred on each station's line (every inside point lies on one station's line): the peak of a quartic fitted
+//!   to their diameters about the best station, where it follows them (see [`PEAK_SPAN`]), else the best station
+//!   refined.
 //! - An edge's radius: the circle fitted (orthogonal distances) to the outline's points within the edge's own
 //!   radius' [`EDGE_ZONE_DEPTH`] of its tip along the chord (at most half the edge distance; the zone is settled
 //!   by refitting), so that on a round end it is the round's circle; none where the points there are too few, span
