@@ -336,3 +336,34 @@ fn the_bounded_least_squares_step_meets_the_optimality_conditions() {
     }
     assert!(active > 100, "the bounds were reached {active} times");
 }
+
+#[test]
+fn the_minimum_zone_settles_on_noisy_sections_dense_at_their_ends() {
+    // The blade's ellipse (ends of radius 0.72 mm) sampled 1500 times, most densely at its ends, with Gaussian
+    // noise of 2 um, moved and turned: 20 draws. Where the normals turn fast, the linear programme's step misleads;
+    // the fit must still settle, within the least-squares band, at the displacement. (The section that did not
+    // settle before the trust region, a simulated propeller's r500 scanned every 2.5 deg round its nose against
+    // its faces, is not reproduced by this ellipse: the halving steps settled here too, in twice the time.)
+    let nominal = Polygon::blade();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2026);
+    let gauss = rand_distr::Normal::new(0.0, 0.002).unwrap();
+    for draw in 0..20 {
+        let noisy = nominal.section(|_| rand_distr::Distribution::sample(&gauss, &mut rng));
+        let shift = Vector2::new(rng.gen_range(-0.3..0.3), rng.gen_range(-0.3..0.3));
+        let measured = displaced(&noisy, shift, rng.gen_range(-0.05..0.05));
+        let l2 = fit(&nominal, &measured, FitMode::Full, FitMethod::L2);
+        let zone = fit(&nominal, &measured, FitMode::Full, FitMethod::MinZone);
+        assert!(
+            zone.form.zone_mm <= l2.form.zone_mm + 1e-9,
+            "draw {draw}: {:?} {:?}",
+            zone.form,
+            l2.form
+        );
+        assert!(
+            (zone.dn_mm - shift.y).abs() < 2e-3,
+            "draw {draw}: dn {} for {}",
+            zone.dn_mm,
+            shift.y
+        );
+    }
+}
