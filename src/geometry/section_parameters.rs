@@ -12,10 +12,11 @@
 //! Definitions (each measured the same way on the scanned section and on the nominal, so that their differences
 //! are the errors):
 //! - Between its points the outline is the centripetal Catmull-Rom curve through them.
-//! - The nose and tail are the two outline points farthest apart, each moved out along the chord, where the edge
-//!   is round (see the edge radius below), to the farthest reach of the smooth outline beside it (a scan's points
-//!   step round a nose, and the farthest of them misses its tip by a few microns), or where it is sharp and the
-//!   scan's compensation names the contacts of its ball rolling round it, to their mean; the chord joins them. The
+//! - The nose and tail are the two outline points farthest apart, each moved, where the edge is round (see the
+//!   edge radius below), to the peak of a quartic fitted across the points within 50 deg of its tip (a scan's
+//!   points step round a nose, each with the probe's noise; where they are too few, to the farthest reach of the
+//!   smooth outline beside the farthest point), or where it is sharp and the scan's compensation names the
+//!   contacts of its ball rolling round it, to their mean; the chord joins them. The
 //!   leading edge is the blunter end: the one whose section is thicker at `EDGE_PROBE` of the chord in from it (an
 //!   airfoil's round nose against its thin tail).
 //! - Stations run along the chord from the leading edge: at station `s` the line across the section perpendicular
@@ -73,6 +74,14 @@ const EDGE_ZONE_DEPTH: f64 = 0.25;
 /// A sharp edge's contacts lie within about 12 um of its apex (2 um noise; the compensation's tests): those this
 /// close to the end's farthest point are its tip's estimates.
 const SHARP_TIP_REACH_MM: f64 = 0.03;
+/// A round end's tip is fitted to the points within this angle of it (on the edge's circle), by a polynomial of
+/// this degree, from at least this many points; its peak is looked for among this many places across them first.
+/// Over 50 deg the quartic is off a NACA nose's tip by 0.4 um at most; over 35 deg it averages less of the noise
+/// (0.7 against 0.6 um at 2.5 deg steps), a quadratic is off by 1-6 um (BENCHMARKS.md, issue 16).
+const NOSE_SPAN_DEG: f64 = 50.0;
+const NOSE_DEGREE: usize = 4;
+const NOSE_MIN_POINTS: usize = 9;
+const NOSE_LOOKS: usize = 64;
 /// Fits by which the zone is settled.
 const EDGE_ZONE_ROUNDS: usize = 3;
 /// Points at least, for an edge's circle.
@@ -181,13 +190,9 @@ pub(crate) fn section_parameters(
     } else {
         (b, a)
     };
-    // A round end's tip lies beyond its farthest point: the outline's points step round a nose by several
-    // degrees (10 at the simulated scan's nose), so the farthest of them falls short of the tip by r (1 - cos a),
-    // a its angle from the tip: up to 5 um on a 2.5 mm nose, differently on every scan. The end is moved out along
-    // the chord to the smooth outline's farthest reach beside it. (From the edge's circle instead, the shortfall
-    // came out 6 um too long on a cambered nose: the circle fitted over 83 deg of a nose whose curvature differs
-    // on its two faces has its centre off to one side, which makes every point seem off the tip.) A dense outline
-    // (a nominal's) keeps its own tip. The edge thicknesses are taken from the moved ends.
+    // A round end's tip is the peak of the nose fitted to the points round it (see `round_tip`), or where they
+    // are too few, the smooth outline's farthest reach beside the farthest point. The edge thicknesses are taken
+    // from the moved ends.
     let inward = (trailing_edge - leading_edge).normalize();
     let zone_mm = edge_distance_mm / 2.0;
     let le_circle = edge_circle(outline, leading_edge, inward, zone_mm);
@@ -195,15 +200,13 @@ pub(crate) fn section_parameters(
     // A sharp end scanned by a rolling ball has many contacts, all noisy estimates of its apex: the farthest of
     // them stands a few microns proud (the trailing edges of the simulated blades read 1-5 um long, +2.7 um on
     // average), their mean does not.
-    let to_tip = |end: Vector2<f64>, round: bool, outward: Vector2<f64>| {
-        if round {
-            end + outward * smooth_reach_beyond(outline, end, outward)
-        } else {
-            sharp_tip(outline, sharp_edge_contacts, end)
-        }
+    let to_tip = |end: Vector2<f64>, circle: Option<&Circle>, outward: Vector2<f64>| match circle {
+        Some(circle) => round_tip(outline, end, outward, circle.radius)
+            .unwrap_or_else(|| end + outward * smooth_reach_beyond(outline, end, outward)),
+        None => sharp_tip(outline, sharp_edge_contacts, end),
     };
-    let leading_edge = to_tip(leading_edge, le_circle.is_some(), -inward);
-    let trailing_edge = to_tip(trailing_edge, te_circle.is_some(), inward);
+    let leading_edge = to_tip(leading_edge, le_circle.as_ref(), -inward);
+    let trailing_edge = to_tip(trailing_edge, te_circle.as_ref(), inward);
     let chord_mm = (trailing_edge - leading_edge).norm();
     let across = Across::new(outline, leading_edge, trailing_edge);
     let le_thickness_mm = across.thickness_at(edge_distance_mm)?;
@@ -574,6 +577,51 @@ impl CatmullRom {
         );
         blend(blend(a1, a2, t0, t2), blend(a2, a3, t1, t3), t1, t2)
     }
+}
+
+/// A round end's tip: where the nose fitted to the outline's points round it reaches farthest along `outward`
+/// (unit). The nose is a polynomial of [`NOSE_DEGREE`] giving the depth along `outward` of the points across it,
+/// fitted to the points within [`NOSE_SPAN_DEG`] of the tip on a circle of the edge's `radius`. `None` where those
+/// points are fewer than [`NOSE_MIN_POINTS`], or the fit peaks at their first or last (no tip between them).
+///
+/// Why a fit: a scan's points step round a nose by several degrees, each with the probe's noise, so the farthest
+/// of them is one noisy point that falls short of the tip by r (1 - cos a), a its angle from the tip. Moved out to
+/// the smooth outline's reach beside it, it still carries a point's noise: 2 um noise read the tip of NACA noses
+/// stepped by 2.5-10 deg with a spread of 1.5-2.1 um and up to 6 um off, where this fit spreads 0.6 um (2.5 deg
+/// steps) to 1.4 um (10 deg), and is off by at most 0.4 um without noise (BENCHMARKS.md, issue 16). Not the edge's
+/// circle: a NACA nose's curvature differs on its two faces, so a circle's centre sits off to one side and its
+/// reach came out 6 um long on a cambered nose; the quartic follows that asymmetry.
+fn round_tip(
+    outline: &[Vector2<f64>],
+    end: Vector2<f64>,
+    outward: Vector2<f64>,
+    radius: f64,
+) -> Option<Vector2<f64>> {
+    let across = Vector2::new(-outward.y, outward.x);
+    let depth = radius * (1.0 - NOSE_SPAN_DEG.to_radians().cos());
+    let nose: Vec<(f64, f64)> = outline
+        .iter()
+        .map(|p| p - end)
+        .filter(|d| -d.dot(&outward) <= depth)
+        .map(|d| (d.dot(&across), d.dot(&outward)))
+        .collect();
+    if nose.len() < NOSE_MIN_POINTS {
+        return None;
+    }
+    let (low, high) = nose
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.0), h.max(p.0))
+        });
+    let reach = fit_polynomial(&nose, NOSE_DEGREE)?;
+    // The quartic of a nose is unimodal over its points; the best of a coarse look brackets the golden search.
+    let step = (high - low) / NOSE_LOOKS as f64;
+    let best = (0..=NOSE_LOOKS)
+        .map(|k| low + step * k as f64)
+        .fold(low, |a, t| if reach(t) > reach(a) { t } else { a });
+    let at = golden_max((best - step).max(low), (best + step).min(high), &reach);
+    let inside = at - low > step && high - at > step;
+    inside.then(|| end + across * at + outward * reach(at))
 }
 
 /// How far beyond the outline point `end` the smooth outline through the points reaches along `outward`, on the

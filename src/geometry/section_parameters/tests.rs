@@ -52,7 +52,9 @@ fn an_ellipses_parameters_are_its_axes_wherever_it_lies_and_however_it_is_turned
     for (angle, shift) in [(0.0, Vector2::zeros()), (27.5, Vector2::new(310.0, -42.0))] {
         let outline = moved(&ellipse(a, b, 4000), angle, shift);
         let p = section_parameters(&outline, &[], 2.0).unwrap();
-        assert!((p.chord_mm - 100.0).abs() < 1e-9, "{}", p.chord_mm);
+        // Each end is the peak of a quartic fitted across its nose (of radius b^2 / a = 0.5 mm), which the
+        // ellipse's higher terms put 0.03 um inside it.
+        assert!((p.chord_mm - 100.0).abs() < 1e-4, "{}", p.chord_mm);
         assert!(
             (p.max_thickness_mm - 10.0).abs() < 1e-4,
             "{}",
@@ -89,10 +91,12 @@ fn a_naca_0012_section_has_its_published_thickness_at_30_percent_and_its_nose_is
 {
     let outline = moved(&naca("0012", 3000), -12.0, Vector2::new(0.0, 250.0));
     let p = section_parameters(&outline, &[], 5.0).unwrap();
-    assert!((p.chord_mm - 100.0).abs() < 1e-6, "{}", p.chord_mm);
+    // The nose is the peak of a quartic fitted across it, which NACA's nose (x ~ y^2 + |y|^3 near its tip) puts
+    // 0.35 um beyond it: the same on a scan as on its nominal, so their difference keeps it out.
+    assert!((p.chord_mm - 100.0).abs() < 5e-4, "{}", p.chord_mm);
     // The nose is the blunt end: the leading edge, at the moved origin.
     assert!(
-        (p.leading_edge - Vector2::new(0.0, 250.0)).norm() < 1e-6,
+        (p.leading_edge - Vector2::new(0.0, 250.0)).norm() < 5e-4,
         "{}",
         p.leading_edge
     );
@@ -370,6 +374,11 @@ fn a_nose_scanned_in_10_degree_steps_keeps_its_tip_whatever_the_steps_phase() {
 /// along the outline (from `phase` of a step on) or where its direction has turned another 10 deg, whichever
 /// comes first.
 fn stepped(dense: &[Vector2<f64>], step: f64, phase: f64) -> Vec<Vector2<f64>> {
+    stepped_by(dense, step, phase, 10.0)
+}
+
+/// As [`stepped`], with a point wherever the direction has turned another `angle_deg`.
+fn stepped_by(dense: &[Vector2<f64>], step: f64, phase: f64, angle_deg: f64) -> Vec<Vector2<f64>> {
     let direction = |i: usize| {
         let t = dense[(i + 1) % dense.len()] - dense[i];
         t.y.atan2(t.x)
@@ -381,7 +390,7 @@ fn stepped(dense: &[Vector2<f64>], step: f64, phase: f64) -> Vec<Vector2<f64>> {
         let turned = (direction(i) - last_angle + std::f64::consts::PI)
             .rem_euclid(std::f64::consts::TAU)
             - std::f64::consts::PI;
-        if travelled >= step || turned.abs() >= 10f64.to_radians() {
+        if travelled >= step || turned.abs() >= angle_deg.to_radians() {
             out.push(dense[i]);
             travelled = 0.0;
             last_angle = direction(i);
@@ -464,4 +473,29 @@ fn a_sharp_edges_tip_is_the_mean_of_the_contacts_rolling_round_it() {
     assert!(mean(&farthest) > 0.002, "farthest: {farthest:?}");
     assert!(mean(&named).abs() < 0.0005, "named: {named:?}");
     assert!(worst(&named) < 0.002, "named: {named:?}");
+}
+
+#[test]
+fn a_noisy_nose_scanned_every_2_5_degrees_has_its_tip_within_two_microns() {
+    // NACA 4412 and 0012 at 100 mm (nose radii 1.6 mm) stepped 1 mm along the faces and 2.5 deg round the nose,
+    // 2 um noise, 20 draws each. The tip along the chord, against the dense outline's: the nose fitted across its
+    // points averages the noise (0.6 um RMS, 1.6 um at worst in a longer campaign); the farthest point moved out
+    // to the smooth outline's reach carried one point's noise (1.5 um RMS, 6 um at worst).
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let mut errors = Vec::new();
+    for digits in ["4412", "0012"] {
+        let dense = naca(digits, 20_000);
+        let truth = section_parameters(&dense, &[], 2.0).unwrap();
+        let out = (truth.leading_edge - truth.trailing_edge).normalize();
+        for draw in 0..20 {
+            let scan = noisy(&stepped_by(&dense, 1.0, rng.gen(), 2.5), 0.002, draw);
+            let measured = section_parameters(&scan, &[], 2.0).unwrap();
+            errors.push((measured.leading_edge - truth.leading_edge).dot(&out));
+        }
+    }
+    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+    let worst = errors.iter().fold(0.0f64, |w, e| w.max(e.abs()));
+    assert!(rms < 0.001, "RMS {rms} mm");
+    assert!(worst < 0.002, "worst {worst} mm");
 }
