@@ -4,10 +4,11 @@
 //! are given in the part frame of the master; the plan moves them onto each instance and into machine
 //! coordinates, so the scheduler and the machine workers only ever see machine coordinates.
 
-use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
 
+use crate::analysis::edges::SharpEdge;
 use crate::analysis::reference::Reference;
 use crate::analysis::section::BestFitSettings;
 use crate::analysis::NominalPoint;
@@ -201,26 +202,51 @@ impl Plan {
     /// The curve scan of any instance's profile along the nominals taught on the master (part frame),
     /// moved onto the instance in machine coordinates. Closed, and starting at the nominal whose normal
     /// points most nearly up (+z in machine coordinates), so the approach from the clearance height above
-    /// it is a straight vertical move.
-    pub fn curve_scan(&self, key: ProfileKey, nominals: &[NominalPoint]) -> CurveScan {
+    /// it is a straight vertical move. `sharp_edges` are the profile's, found in the master's scan: their
+    /// rolls keep the scan's `max_angle_deg`, the rest of the profile may be scanned finer round its round
+    /// edges (see [`ScanSettings::round_edge_max_angle_deg`]).
+    pub fn curve_scan(
+        &self,
+        key: ProfileKey,
+        nominals: &[NominalPoint],
+        sharp_edges: &[SharpEdge],
+    ) -> CurveScan {
         let placement = self.instance_to_machine(key.instance);
         let first = if nominals.is_empty() {
             0
         } else {
             self.upmost(key, nominals)
         };
-        let nominals: Vec<Nominal> = nominals[first..]
-            .iter()
-            .chain(&nominals[..first])
+        let in_order = || nominals[first..].iter().chain(&nominals[..first]);
+        let rolling: Vec<bool> = in_order()
+            .map(|n| {
+                sharp_edges.iter().any(|edge| {
+                    (Vector2::new(n.point[1], n.point[2]) - Vector2::from(edge.apex)).norm()
+                        <= ROLL_REACH_MM
+                })
+            })
+            .collect();
+        let nominals: Vec<Nominal> = in_order()
             .map(|n| Nominal {
                 point: xyz(&(placement * Point3::from(n.point)).coords),
                 normal: xyz(&(placement * Vector3::from(n.normal)).normalize()),
             })
             .collect();
         let scan = &self.part.scan;
+        let angle = scan.max_angle_deg.to_radians();
+        let round_edge_angle = scan
+            .round_edge_max_angle_deg
+            .map_or(angle, |a| a.to_radians().min(angle));
+        let max_angle = |i: usize, j: usize| {
+            if rolling[i] || rolling[j] {
+                angle
+            } else {
+                round_edge_angle
+            }
+        };
         CurveScan {
             closed: true,
-            nominals: at_density(&nominals, scan.step_mm, scan.max_angle_deg.to_radians()),
+            nominals: at_density(&nominals, scan.step_mm, max_angle),
             max_deviation: scan.max_deviation_mm,
             min_radius: scan.min_radius_mm,
             density: Density::AtNominals,
@@ -381,18 +407,23 @@ impl Plan {
 }
 
 /// The nominals of a closed curve scan at the scan's density: between two taught nominals farther apart than
-/// `max_distance` mm, or whose normals turn by more than `max_angle` rad, evenly spaced ones are put in (their
-/// normals interpolated). Why the station does it rather than the machine (`ScanOnCurveDensity(Dis, Angle)`):
+/// `max_distance` mm, or whose normals turn by more than `max_angle(i, j)` rad (nominals i and j), evenly spaced
+/// ones are put in (their normals interpolated). Why the station does it rather than the machine (`ScanOnCurveDensity(Dis, Angle)`):
 /// with `AtNominals` the machine reports exactly one point per nominal, so a scan that comes back a point short
 /// has lost one, however few (a data line of one point lost at a scan's end leaves no hole its spacing shows).
-fn at_density(nominals: &[Nominal], max_distance: f64, max_angle: f64) -> Vec<Nominal> {
+fn at_density(
+    nominals: &[Nominal],
+    max_distance: f64,
+    max_angle: impl Fn(usize, usize) -> f64,
+) -> Vec<Nominal> {
     let n = nominals.len();
     if n < 3 {
         return nominals.to_vec();
     }
     let mut out = Vec::with_capacity(2 * n);
     for i in 0..n {
-        let (a, b) = (nominals[i], nominals[(i + 1) % n]);
+        let j = (i + 1) % n;
+        let (a, b) = (nominals[i], nominals[j]);
         out.push(a);
         let (pa, pb) = (
             Vector3::new(a.point.x, a.point.y, a.point.z),
@@ -404,7 +435,7 @@ fn at_density(nominals: &[Nominal], max_distance: f64, max_angle: f64) -> Vec<No
         );
         let pieces = ((pb - pa).norm() / max_distance)
             .ceil()
-            .max((na.angle(&nb) / max_angle).ceil())
+            .max((na.angle(&nb) / max_angle(i, j)).ceil())
             .max(1.0) as usize;
         for k in 1..pieces {
             let f = k as f64 / pieces as f64;
@@ -416,6 +447,10 @@ fn at_density(nominals: &[Nominal], max_distance: f64, max_angle: f64) -> Vec<No
     }
     out
 }
+
+/// A taught nominal this close to a sharp edge's apex, in its profile's plane (mm), is one of the contacts of the
+/// ball rolling round the edge: the compensation finds those within about 12 um of the apex.
+const ROLL_REACH_MM: f64 = 0.1;
 
 fn xyz(v: &Vector3<f64>) -> Xyz {
     Xyz::new(v.x, v.y, v.z)

@@ -85,6 +85,12 @@ pub struct ScanSettings {
     pub min_radius_mm: f64,
     /// A curve scan reports a point wherever the path turns by more than this.
     pub max_angle_deg: f64,
+    /// Round the tight curves of a profile (a blade's round nose) a curve scan reports a point wherever the path
+    /// turns by more than this instead, where it is smaller: a round edge's tip is fitted to the points within 50
+    /// deg of it, and more points there average more of the probe's noise. A sharp edge's roll keeps
+    /// `max_angle_deg`. Absent: `max_angle_deg` everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub round_edge_max_angle_deg: Option<f64>,
 }
 
 /// The band a deviation must lie in for the instance to pass, and the tolerances on its sections' and blades'
@@ -306,10 +312,17 @@ impl ScanSettings {
         {
             return Err(format!("[scan] {key} = {value} must be above zero"));
         }
-        if !(self.max_angle_deg > 0.0 && self.max_angle_deg < 180.0) {
+        let angles = [
+            ("max_angle_deg", Some(self.max_angle_deg)),
+            ("round_edge_max_angle_deg", self.round_edge_max_angle_deg),
+        ];
+        if let Some((key, value)) = angles.iter().find_map(|(key, value)| {
+            value
+                .filter(|v| !(*v > 0.0 && *v < 180.0))
+                .map(|v| (key, v))
+        }) {
             return Err(format!(
-                "[scan] max_angle_deg = {} must lie between 0 and 180 degrees",
-                self.max_angle_deg
+                "[scan] {key} = {value} must lie between 0 and 180 degrees"
             ));
         }
         Ok(())

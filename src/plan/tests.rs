@@ -15,8 +15,15 @@ fn propeller_part() -> PartConfig {
         .unwrap()
 }
 
+/// The propeller's part file, every curve scan's density set by `max_angle_deg` alone.
+fn part_at_max_angle() -> PartConfig {
+    let mut part = propeller_part();
+    part.scan.round_edge_max_angle_deg = None;
+    part
+}
+
 fn plan() -> Plan {
-    Plan::new(&propeller_part(), Isometry3::identity())
+    Plan::new(&part_at_max_angle(), Isometry3::identity())
 }
 
 fn simulated_propeller() -> Propeller {
@@ -206,7 +213,7 @@ fn circle() -> Vec<NominalPoint> {
 fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
     let plan = plan();
     let nominals = circle();
-    let scan = plan.curve_scan(key(0, 1), &nominals);
+    let scan = plan.curve_scan(key(0, 1), &nominals, &[]);
     assert!(scan.closed);
     // Each taught step (30 deg, 5.18 mm) is cut into PER_STEP at the scan's 1 mm: taught nominal k is the
     // scan's PER_STEP k-th.
@@ -248,9 +255,46 @@ fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
 }
 
 #[test]
+fn round_edges_are_scanned_finer_and_a_sharp_edges_roll_keeps_the_scans_angle() {
+    // The taught circle (radius 10 mm, a nominal every 30 deg, 5.18 mm apart): at 4 deg round its round edges
+    // each step is cut in 8 (the scan's 1 mm would cut it in 6); beside a sharp edge's apex (at the nominal of
+    // 0 deg, (y, z) = (10, 20)) the scan's 10 deg and 1 mm leave 6.
+    let mut part = propeller_part();
+    part.scan.round_edge_max_angle_deg = Some(4.0);
+    let plan = Plan::new(&part, Isometry3::identity());
+    let turn = |a: &Xyz, b: &Xyz| {
+        Vector3::new(a.x, a.y, a.z)
+            .angle(&Vector3::new(b.x, b.y, b.z))
+            .to_degrees()
+    };
+    let largest_turn = |scan: &CurveScan| {
+        let n = scan.nominals.len();
+        (0..n)
+            .map(|i| turn(&scan.nominals[i].normal, &scan.nominals[(i + 1) % n].normal))
+            .fold(0.0, f64::max)
+    };
+    let round = plan.curve_scan(key(0, 1), &circle(), &[]);
+    assert_eq!(round.nominals.len(), 12 * 8);
+    assert!(largest_turn(&round) <= 4.0, "{}", largest_turn(&round));
+    let edge = SharpEdge {
+        apex: [10.0, 20.0],
+        from_normal: [0.0, 1.0],
+        turn_rad: -std::f64::consts::FRAC_PI_2,
+    };
+    let sharp = plan.curve_scan(key(0, 1), &circle(), &[edge]);
+    assert_eq!(sharp.nominals.len(), 10 * 8 + 2 * 6);
+    // Six pieces of 30 deg by normals interpolated along their chord: about 5 deg, 5.1 at the middle.
+    let beside_edge = largest_turn(&sharp);
+    assert!(beside_edge > 5.0 && beside_edge < 5.2, "{beside_edge}");
+    // Without the key every step is cut at the scan's own 1 mm and 10 deg.
+    let coarse = self::plan().curve_scan(key(0, 1), &circle(), &[edge]);
+    assert_eq!(coarse.nominals.len(), 12 * PER_STEP);
+}
+
+#[test]
 fn a_curve_scan_on_blade_b_turns_points_and_normals() {
     let plan = plan();
-    let scan = plan.curve_scan(key(1, 1), &circle());
+    let scan = plan.curve_scan(key(1, 1), &circle(), &[]);
     let (cos, sin) = TURN_120;
     // The top (200, 0, 30) turned onto blade B; its normal, up, stays up.
     assert_near(
@@ -278,8 +322,8 @@ fn a_fixture_turn_that_tilts_nothing_keeps_the_upward_start() {
         rot_z_deg: 37.0,
         ..Pose::default()
     };
-    let plan = Plan::new(&propeller_part(), turned.isometry());
-    let scan = plan.curve_scan(key(2, 0), &circle());
+    let plan = Plan::new(&part_at_max_angle(), turned.isometry());
+    let scan = plan.curve_scan(key(2, 0), &circle(), &[]);
     assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
     let z: Vec<f64> = scan.nominals.iter().map(|n| n.point.z).collect();
     assert_eq!(z.len(), 12 * PER_STEP);

@@ -83,7 +83,8 @@ pub fn scan_motion(
     let name = format!("part {}, {}", plan.part(), plan.describe(key));
     let (scan, path, kind) = match reference {
         Some(reference) => {
-            let scan = plan.curve_scan(key, &reference.profiles[key.profile].nominals);
+            let profile = &reference.profiles[key.profile];
+            let scan = plan.curve_scan(key, &profile.nominals, &profile.edges);
             let path = KnownPath::of_curve_scan(&scan);
             (Scan::Curve(scan), path, JobKind::Inspect)
         }
