@@ -177,6 +177,23 @@ fn the_minimum_zone_of_a_one_sided_bump_is_its_height_where_least_squares_keeps_
     assert!((l2.dn_mm - 0.3).abs() < 1e-4, "{}", l2.dn_mm);
 }
 
+/// The full least-squares and minimum-zone fits of `measured`, the zone checked within the least-squares band.
+fn both_fits_zone_within_l2(
+    nominal: &Polygon,
+    measured: &[Vector2<f64>],
+    what: &str,
+) -> (SectionFit, SectionFit) {
+    let l2 = fit(nominal, measured, FitMode::Full, FitMethod::L2);
+    let zone = fit(nominal, measured, FitMode::Full, FitMethod::MinZone);
+    assert!(
+        zone.form.zone_mm <= l2.form.zone_mm + 1e-9,
+        "{what}: min zone {:?}, L2 {:?}",
+        zone.form,
+        l2.form
+    );
+    (l2, zone)
+}
+
 #[test]
 fn the_minimum_zone_is_never_wider_than_the_least_squares_band() {
     let nominal = Polygon::blade();
@@ -189,14 +206,7 @@ fn the_minimum_zone_is_never_wider_than_the_least_squares_band() {
             noise[k - 1]
         });
         let measured = displaced(&noisy, Vector2::new(0.2, -0.1), 0.05);
-        let l2 = fit(&nominal, &measured, FitMode::Full, FitMethod::L2);
-        let zone = fit(&nominal, &measured, FitMode::Full, FitMethod::MinZone);
-        assert!(
-            zone.form.zone_mm <= l2.form.zone_mm + 1e-9,
-            "min zone {:?}, L2 {:?}",
-            zone.form,
-            l2.form
-        );
+        let (l2, zone) = both_fits_zone_within_l2(&nominal, &measured, "");
         assert!(zone.form.zone_mm <= 0.008 + 1e-9);
         // Both see the same displacement, within what the noise allows.
         assert!((l2.dn_mm + 0.1).abs() < 5e-4 && (zone.dn_mm + 0.1).abs() < 2e-3);
@@ -351,14 +361,7 @@ fn the_minimum_zone_settles_on_noisy_sections_dense_at_their_ends() {
         let noisy = nominal.section(|_| rand_distr::Distribution::sample(&gauss, &mut rng));
         let shift = Vector2::new(rng.gen_range(-0.3..0.3), rng.gen_range(-0.3..0.3));
         let measured = displaced(&noisy, shift, rng.gen_range(-0.05..0.05));
-        let l2 = fit(&nominal, &measured, FitMode::Full, FitMethod::L2);
-        let zone = fit(&nominal, &measured, FitMode::Full, FitMethod::MinZone);
-        assert!(
-            zone.form.zone_mm <= l2.form.zone_mm + 1e-9,
-            "draw {draw}: {:?} {:?}",
-            zone.form,
-            l2.form
-        );
+        let (_, zone) = both_fits_zone_within_l2(&nominal, &measured, &format!("draw {draw}"));
         assert!(
             (zone.dn_mm - shift.y).abs() < 2e-3,
             "draw {draw}: dn {} for {}",
