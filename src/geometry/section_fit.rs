@@ -135,6 +135,15 @@ struct Placement {
     x: Vector3<f64>,
 }
 
+impl Placement {
+    /// This placement moved by `step`, each unknown held within its limit `bound`.
+    fn stepped(&self, step: &Vector3<f64>, bound: &Vector3<f64>) -> Placement {
+        Placement {
+            x: (self.x + step).zip_map(bound, |x, b| x.clamp(-b, b)),
+        }
+    }
+}
+
 /// The section's own axes: the pivot its turn is about, the chord's unit direction and the thickness direction
 /// (the chord turned +90 degrees). A measured point p is brought onto the nominal by the inverse of a placement:
 /// q = R(-turn) (p - pivot - displacement) + pivot.
@@ -258,9 +267,7 @@ pub(crate) fn fit_section(
                     let current = sum_of_squares(&measured);
                     let mut improved = None;
                     for _ in 0..30 {
-                        let candidate = Placement {
-                            x: (placement.x + trial).zip_map(&bound, |x, b| x.clamp(-b, b)),
-                        };
+                        let candidate = placement.stepped(&trial, &bound);
                         let next = measure_all(&candidate)?;
                         if sum_of_squares(&next) < current * (1.0 - L2_GAIN) {
                             improved = Some((candidate, next));
@@ -454,9 +461,7 @@ impl ZoneStep<'_> {
             .abs()
             .max(step.y.abs())
             .max(step.z.abs() * self.reach);
-        let candidate = Placement {
-            x: (self.placement.x + step).zip_map(self.bound, |x, b| x.clamp(-b, b)),
-        };
+        let candidate = self.placement.stepped(&step, self.bound);
         let next = measure_all(&candidate)?;
         let ratio = (current - current_worst(&next)) / expected;
         if ratio >= ZONE_ACCEPT {
