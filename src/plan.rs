@@ -408,9 +408,10 @@ impl Plan {
 
 /// The nominals of a closed curve scan at the scan's density: between two taught nominals farther apart than
 /// `max_distance` mm, or whose normals turn by more than `max_angle(i, j)` rad (nominals i and j), evenly spaced
-/// ones are put in (their normals interpolated). Why the station does it rather than the machine (`ScanOnCurveDensity(Dis, Angle)`):
-/// with `AtNominals` the machine reports exactly one point per nominal, so a scan that comes back a point short
-/// has lost one, however few (a data line of one point lost at a scan's end leaves no hole its spacing shows).
+/// ones are put in (their normals interpolated). Why the station does it rather than the machine
+/// (`ScanOnCurveDensity(Dis, Angle)`): with `AtNominals` the machine reports exactly one point per nominal, so a
+/// scan that comes back a point short has lost one, however few (a data line of one point lost at a scan's end
+/// leaves no hole its spacing shows).
 fn at_density(
     nominals: &[Nominal],
     max_distance: f64,
