@@ -12,7 +12,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use futures::StreamExt;
 use nalgebra::Point2;
 use zeroset_drivers::client::{Client, ClientConfig};
-use zeroset_drivers::machine::{InPlaneScan, Machine, Speeds, Xyz};
+use zeroset_drivers::machine::{InPlaneScan, InPlaneSpacing, Machine, Speeds, Xyz};
 use zeroset_drivers::transport::open_pty;
 use zeroset_sim::config::{PartSpec, SimConfig};
 use zeroset_sim::part::curve::SampledCurve;
@@ -95,7 +95,7 @@ async fn scan(client: &Client, top: Xyz) -> usize {
         start_normal: Xyz::new(0.0, 0.0, 1.0),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: Xyz::new(top.x, top.y + 10.0, top.z),
-        step: 0.5,
+        spacing: InPlaneSpacing::Step(0.5),
         end: Xyz::new(top.x, top.y, top.z + 1.0),
         stop_diameter: 3.0,
         passes: 1,

@@ -6,7 +6,7 @@
 
 use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Nominal, Xyz};
+use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, InPlaneSpacing, Nominal, Xyz};
 
 use crate::analysis::edges::SharpEdge;
 use crate::analysis::reference::Reference;
@@ -191,7 +191,7 @@ impl Plan {
             start_normal: direction(normal),
             plane_normal: xyz(&self.plane_normal(key.instance)),
             direction: point(start + heading * HEADING_POINT_MM),
-            step: self.part.scan.step_mm,
+            spacing: InPlaneSpacing::Step(self.part.scan.step_mm),
             end: point(start + normal * STOP_CENTRE_OFF_START_MM),
             stop_diameter: self.part.scan.stop_diameter_mm,
             passes: 1,

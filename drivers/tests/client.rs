@@ -12,8 +12,8 @@ use tokio::io::DuplexStream;
 use tokio::task::JoinHandle;
 use zeroset_drivers::client::{Client, ClientConfig};
 use zeroset_drivers::machine::{
-    CurveScan, Density, Error, ErrorKind, Event, InPlaneScan, Machine, MoveReportRate, Nominal,
-    TransportError, Xyz,
+    CurveScan, Density, Error, ErrorKind, Event, InPlaneScan, InPlaneSpacing, Machine,
+    MoveReportRate, Nominal, TransportError, Xyz,
 };
 use zeroset_drivers::wire::EventTag;
 
@@ -58,7 +58,7 @@ fn in_plane_plan() -> InPlaneScan {
         start_normal: Xyz::new(0.0, 0.0, 1.0),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: Xyz::new(0.0, 1.0, 0.0),
-        step: 0.5,
+        spacing: InPlaneSpacing::Step(0.5),
         end: Xyz::new(0.0, 9.0, 0.0),
         stop_diameter: 1.4,
         passes: 1,

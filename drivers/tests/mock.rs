@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use futures_util::{stream, StreamExt};
 use zeroset_drivers::machine::{
-    InPlaneScan, Machine, MockMachine, MockScanning, ScanPoint, ScanStream, Xyz,
+    InPlaneScan, InPlaneSpacing, Machine, MockMachine, MockScanning, ScanPoint, ScanStream, Xyz,
 };
 
 /// What a station worker does first: home if needed, then scan, collecting the points.
@@ -28,7 +28,7 @@ async fn a_mock_machine_stands_in_for_the_client() {
     let mut scanning = MockScanning::new();
     scanning
         .expect_scan_in_plane()
-        .withf(|plan| plan.step == 0.25)
+        .withf(|plan| plan.spacing == InPlaneSpacing::Step(0.25))
         .times(1)
         .returning(move |_| Ok(ScanStream::new(stream::iter([Ok(point), Ok(point)]))));
     let scanning = Arc::new(scanning);
@@ -45,7 +45,7 @@ async fn a_mock_machine_stands_in_for_the_client() {
         start_normal: Xyz::new(0.0, 0.0, 1.0),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: Xyz::new(0.0, 1.0, 0.0),
-        step: 0.25,
+        spacing: InPlaneSpacing::Step(0.25),
         end: Xyz::new(0.0, 0.0, 0.0),
         stop_diameter: 1.0,
         passes: 1,

@@ -10,7 +10,7 @@ use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
 use peer::Peer;
 use tokio::net::TcpListener;
 use zeroset_drivers::client::{Client, ClientConfig};
-use zeroset_drivers::machine::{InPlaneScan, Machine, Xyz};
+use zeroset_drivers::machine::{InPlaneScan, InPlaneSpacing, Machine, Xyz};
 use zeroset_drivers::transport::{connect_tcp, open_pty};
 
 #[tokio::test]
@@ -42,7 +42,7 @@ async fn a_session_and_a_scan_cross_a_raw_pseudo_terminal() {
         start_normal: Xyz::new(0.0, 0.0, 1.0),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: Xyz::new(200.0, 1.0, 10.0),
-        step: 0.5,
+        spacing: InPlaneSpacing::Step(0.5),
         end: Xyz::new(200.0, 0.0, 10.0),
         stop_diameter: 1.0,
         passes: 1,

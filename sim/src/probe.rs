@@ -131,15 +131,24 @@ enum PathNode {
 const TRACE_SAMPLES: usize = 4000;
 const CORNER_TURN: f64 = 0.035;
 
+/// How densely a plane scan reports points: every `max_distance` mm of centre travel at most, and, where
+/// `max_angle` is given (rad), wherever the surface normal has turned by that much since the last point (I++'s
+/// `StepW`, or `ScanUnknownDensity(Dis(..), Angle(..))` with `StepW` 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spacing {
+    pub max_distance: f64,
+    pub max_angle: Option<f64>,
+}
+
 /// Scans a section with the ball: from the contact nearest `start` (a ball centre on the section's
-/// plane), in the sense that heads towards `towards`, points every `step` mm of centre travel until the
-/// stop sphere. Returns the contacts, the first being the start.
+/// plane), in the sense that heads towards `towards`, points as `spacing` asks until the stop sphere. Returns
+/// the contacts, the first being the start.
 pub fn plane_scan(
     section: &Section,
     radius: f64,
     start: Point3<f64>,
     towards: Point3<f64>,
-    step: f64,
+    spacing: Spacing,
     stop: StopSphere,
 ) -> Result<Vec<Contact>, PlaneScanError> {
     let curve = &section.curve;
@@ -178,7 +187,9 @@ pub fn plane_scan(
     let distance_to_stop = |c: &Contact| (c.centre - stop.centre).norm();
     let mut inside = distance_to_stop(&contacts[0]) < stop.radius;
     let mut entries = 0;
+    // Centre travel since the last point, and the normal's angle there.
     let mut travelled_since = 0.0;
+    let mut last_angle = angle_of(&place(nodes[0]).1);
     let mut previous = contacts[0];
     for pair in nodes.windows(2) {
         let (a, b) = (to_contact(pair[0]), to_contact(pair[1]));
@@ -186,9 +197,31 @@ pub fn plane_scan(
         if segment == 0.0 {
             continue;
         }
-        let mut along = step - travelled_since;
-        while along <= segment {
-            let node = between(pair[0], pair[1], along / segment);
+        // Along the segment the normal turns evenly from a's angle to b's (the nodes are a few hundredths of
+        // a radian apart).
+        let (angle_a, bend) = {
+            let (from, to) = (angle_of(&place(pair[0]).1), angle_of(&place(pair[1]).1));
+            (from, turn(from, to))
+        };
+        let mut at = 0.0;
+        loop {
+            let by_distance = at + spacing.max_distance - travelled_since;
+            let by_angle = spacing
+                .max_angle
+                .filter(|_| bend != 0.0)
+                .map(|max_angle| {
+                    // Where the turn from the last point, growing the way the segment bends, reaches the
+                    // limit (at once where it already has).
+                    let limit = max_angle.copysign(bend);
+                    ((limit - turn(last_angle, angle_a)) / bend * segment).max(at)
+                })
+                .unwrap_or(f64::INFINITY);
+            let next = by_distance.min(by_angle);
+            if next > segment {
+                travelled_since += segment - at;
+                break;
+            }
+            let node = between(pair[0], pair[1], next / segment);
             let contact = to_contact(node);
             let now_inside = distance_to_stop(&contact) < stop.radius;
             if now_inside && !inside {
@@ -203,9 +236,10 @@ pub fn plane_scan(
             }
             contacts.push(contact);
             previous = contact;
-            along += step;
+            travelled_since = 0.0;
+            last_angle = angle_a + bend * next / segment;
+            at = next;
         }
-        travelled_since = segment - (along - step);
     }
     Err(PlaneScanError::StopSphereNeverReached)
 }
@@ -354,8 +388,19 @@ mod tests {
             radius: 1.5,
             count: 1,
         };
-        let contacts =
-            plane_scan(&section, 1.0, start, Point3::new(11.0, 5.0, 5.0), 1.0, stop).unwrap();
+        let every_mm = Spacing {
+            max_distance: 1.0,
+            max_angle: None,
+        };
+        let contacts = plane_scan(
+            &section,
+            1.0,
+            start,
+            Point3::new(11.0, 5.0, 5.0),
+            every_mm,
+            stop,
+        )
+        .unwrap();
         // Circumference of the centre path 2 pi 11 = 69.1 mm at 1 mm steps: the last is the closest to start.
         assert_eq!(contacts.len(), 70);
         assert!(contacts[1].centre.y > 0.0, "counterclockwise, towards +y");
@@ -366,6 +411,71 @@ mod tests {
             centre: Point3::new(50.0, 0.0, 5.0),
             ..stop
         };
-        assert!(plane_scan(&section, 1.0, start, start, 1.0, never).is_err());
+        assert!(plane_scan(&section, 1.0, start, start, every_mm, never).is_err());
+    }
+
+    #[test]
+    fn a_plane_scan_spaced_by_turn_reports_a_point_wherever_the_normal_has_turned_that_much() {
+        let section = Cylinder
+            .section(&Plane {
+                point: Point3::new(0.0, 0.0, 5.0),
+                normal: Vector3::z(),
+            })
+            .unwrap();
+        let start = Point3::new(11.0, 0.0, 5.0);
+        let stop = StopSphere {
+            centre: start,
+            radius: 0.7,
+            count: 1,
+        };
+        // 3 deg on the centre path of radius 11 mm is 0.58 mm, under the 1 mm distance: the turn sets the
+        // spacing, 120 steps round (121 points, the last back at the start, the closest to the stop sphere's
+        // centre).
+        let spacing = Spacing {
+            max_distance: 1.0,
+            max_angle: Some(3f64.to_radians()),
+        };
+        let contacts = plane_scan(
+            &section,
+            1.0,
+            start,
+            Point3::new(11.0, 5.0, 5.0),
+            spacing,
+            stop,
+        )
+        .unwrap();
+        assert_eq!(contacts.len(), 121);
+        for pair in contacts.windows(2) {
+            let turned = pair[0]
+                .surface
+                .normal
+                .angle(&pair[1].surface.normal)
+                .to_degrees();
+            assert!((turned - 3.0).abs() < 1e-6, "{turned} deg");
+        }
+        // A turn wider than the distance allows: the distance sets it, as with the angle left out.
+        let wide = Spacing {
+            max_distance: 1.0,
+            max_angle: Some(30f64.to_radians()),
+        };
+        let by_distance = Spacing {
+            max_distance: 1.0,
+            max_angle: None,
+        };
+        let (towards, stop) = (
+            Point3::new(11.0, 5.0, 5.0),
+            StopSphere {
+                radius: 1.5,
+                ..stop
+            },
+        );
+        assert_eq!(
+            plane_scan(&section, 1.0, start, towards, wide, stop)
+                .unwrap()
+                .len(),
+            plane_scan(&section, 1.0, start, towards, by_distance, stop)
+                .unwrap()
+                .len()
+        );
     }
 }

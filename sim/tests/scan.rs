@@ -15,25 +15,37 @@ const SCALE: f64 = 100.0;
 /// Noise is 2 um per axis: 7 sigma of one axis bounds every point of a scan.
 const WITHIN_NOISE: f64 = 0.014;
 
-/// The plane scan command around a section: start above `top` probing down, stop back at the start.
+/// The plane scan command around a section: start above `top` probing down, stop back at the start, a point
+/// every 1 mm.
 fn scan_command(
     tag: &str,
     top: Point3<f64>,
     plane_normal: Vector3<f64>,
     towards: Vector3<f64>,
 ) -> String {
+    scan_command_stepped(tag, top, plane_normal, towards, 1.0)
+}
+
+/// ... with `StepW` = `step`.
+fn scan_command_stepped(
+    tag: &str,
+    top: Point3<f64>,
+    plane_normal: Vector3<f64>,
+    towards: Vector3<f64>,
+    step: f64,
+) -> String {
     let d = top + towards * 10.0;
     let e = top + Vector3::z();
     format!(
-        "{tag} ScanInPlaneEndIsSphere({:.5}, {:.5}, {:.5}, 0, 0, 1, {}, {}, {}, {:.5}, {:.5}, {:.5}, 1, \
+        "{tag} ScanInPlaneEndIsSphere({:.5}, {:.5}, {:.5}, 0, 0, 1, {}, {}, {}, {:.5}, {:.5}, {:.5}, {step}, \
          {:.5}, {:.5}, {:.5}, 3, 1, 0, 0, 1)",
         top.x, top.y, top.z, plane_normal.x, plane_normal.y, plane_normal.z, d.x, d.y, d.z, e.x, e.y, e.z
     )
 }
 
-#[test]
-fn a_closed_profile_of_blade_a_at_radius_200_lies_on_its_analytic_section() {
-    let sim = Sim::start(&config_path("propeller.toml"), SCALE);
+/// A session on a homed simulator with Probe1 and scan reports of X, Y, Z and IJK, the probe 20 mm above the
+/// top of blade A's section at radius 200 mm (returned, as a surface point).
+fn above_blade_a_at_200(sim: &Sim) -> (Client, Point3<f64>) {
     let mut client = Client::open(sim.path("cmm1"));
     assert_eq!(
         client.transact("00001 StartSession()"),
@@ -60,15 +72,14 @@ fn a_closed_profile_of_blade_a_at_radius_200_lies_on_its_analytic_section() {
         top.z + 20.0
     );
     assert_eq!(client.transact(&above), ["00008 &", "00008 %"]);
+    (client, top)
+}
 
-    let started = Instant::now();
-    let lines = client.transact(&scan_command("00009", top, Vector3::x(), Vector3::y()));
-    let took = started.elapsed();
-    assert_eq!(lines[0], "00009 &");
-    assert_eq!(lines.last().unwrap(), "00009 %");
-    let values = scan_values(&lines, "00009");
+/// The ball centres and reported normals of a scan's data lines tagged `tag`.
+fn scanned(lines: &[String], tag: &str) -> Vec<(Point3<f64>, Vector3<f64>)> {
+    let values = scan_values(lines, tag);
     assert_eq!(values.len() % 6, 0);
-    let points: Vec<(Point3<f64>, Vector3<f64>)> = values
+    values
         .chunks(6)
         .map(|v| {
             (
@@ -76,7 +87,23 @@ fn a_closed_profile_of_blade_a_at_radius_200_lies_on_its_analytic_section() {
                 Vector3::new(v[3], v[4], v[5]),
             )
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn a_closed_profile_of_blade_a_at_radius_200_lies_on_its_analytic_section() {
+    let sim = Sim::start(&config_path("propeller.toml"), SCALE);
+    let (mut client, top) = above_blade_a_at_200(&sim);
+    let truth = propeller("propeller.toml");
+    let frame = truth.section_frame(0, 200.0);
+    let section = SampledCurve::new(truth.section_curve(0, 200.0));
+
+    let started = Instant::now();
+    let lines = client.transact(&scan_command("00009", top, Vector3::x(), Vector3::y()));
+    let took = started.elapsed();
+    assert_eq!(lines[0], "00009 &");
+    assert_eq!(lines.last().unwrap(), "00009 %");
+    let points = scanned(&lines, "00009");
 
     // Every point: the ball centre minus the radius along the reported normal is on the section.
     for (centre, normal) in &points {
@@ -116,6 +143,60 @@ fn a_closed_profile_of_blade_a_at_radius_200_lies_on_its_analytic_section() {
         machine_seconds > around / 20.0,
         "{machine_seconds} s for {around} mm"
     );
+    assert!(sim.stop().success());
+}
+
+#[test]
+fn a_profile_scanned_with_step_0_is_spaced_by_scan_unknown_density_in_distance_and_turn() {
+    // Spec 11.3.1.1: StepW 0 takes ScanUnknownDensity's spacing. The section at radius 200 mm has a nose of
+    // 2.7 mm radius and a sharp trailing edge the 1 mm ball rolls round: with 1 mm steps the ball's normal
+    // turns by up to 57 deg between points there; spaced by 10 deg as well, by no more than that.
+    let sim = Sim::start(&config_path("propeller.toml"), SCALE);
+    let (mut client, top) = above_blade_a_at_200(&sim);
+    assert_eq!(
+        client.transact("00009 ScanUnknownDensity(Dis(1), Angle(10))"),
+        ["00009 &", "00009 %"]
+    );
+    let spaced = scan_command_stepped("00010", top, Vector3::x(), Vector3::y(), 0.0);
+    let points = scanned(&client.transact(&spaced), "00010");
+    let turns: Vec<f64> = points
+        .windows(2)
+        .map(|w| w[0].1.angle(&w[1].1).to_degrees())
+        .collect();
+    // The reported normals carry the probe's noise: 10 deg within a tenth of a degree.
+    let widest = turns.iter().copied().fold(0.0, f64::max);
+    assert!(widest < 10.1 && widest > 9.0, "widest turn {widest} deg");
+    assert!(points.windows(2).all(|w| (w[1].0 - w[0].0).norm() < 1.05));
+    let by_turn = turns.iter().filter(|&&t| t > 9.0).count();
+    assert!(by_turn > 16, "only {by_turn} points spaced by their turn");
+
+    // The same scan by 1 mm steps: fewer points, turning up to 57 deg round the trailing edge.
+    client.transact("00011 GoTo(X(200), Y(0), Z(100))");
+    let stepped = scanned(
+        &client.transact(&scan_command("00012", top, Vector3::x(), Vector3::y())),
+        "00012",
+    );
+    let widest_stepped = stepped
+        .windows(2)
+        .map(|w| w[0].1.angle(&w[1].1).to_degrees())
+        .fold(0.0, f64::max);
+    assert!(widest_stepped > 30.0, "{widest_stepped} deg");
+    assert!(
+        points.len() > stepped.len() + by_turn / 2,
+        "{} against {}",
+        points.len(),
+        stepped.len()
+    );
+
+    // Refused: a density that is not positive, or none given.
+    for (line, code) in [
+        ("00013 ScanUnknownDensity(Angle(-1))", "0509"),
+        ("00015 ScanUnknownDensity()", "0502"),
+    ] {
+        let reply = client.transact(line);
+        assert!(reply[1].contains(code), "{line}: {reply:?}");
+        client.transact("00014 ClearAllErrors()");
+    }
     assert!(sim.stop().success());
 }
 

@@ -116,7 +116,7 @@ pub fn part_config(data: &[u8]) {
         for value in points
             .iter()
             .flat_map(|p: &Xyz| [p.x, p.y, p.z])
-            .chain([scan.step, scan.stop_diameter])
+            .chain([scan.spacing.max_distance(), scan.stop_diameter])
         {
             Number::from_f64(value).unwrap_or_else(|e| {
                 panic!(

@@ -174,7 +174,10 @@ fn the_teach_scan_of_blade_a_starts_on_the_simulated_surface_in_the_plane_x() {
     assert_near(&scan.direction, [200.0, 10.0, 16.34], "direction point");
     assert_near(&scan.end, [200.0, 0.0, 17.34], "end");
     assert_near(&scan.end_normal, [0.0, 0.0, 1.0], "end normal");
-    assert_eq!((scan.step, scan.stop_diameter, scan.passes), (1.0, 3.0, 1));
+    assert_eq!(
+        (scan.spacing, scan.stop_diameter, scan.passes),
+        (InPlaneSpacing::Step(1.0), 3.0, 1)
+    );
 }
 
 #[test]

@@ -56,7 +56,12 @@ impl fmt::Display for Gap {
 pub fn find_gap(motion: &ScanMotion, centres: &[Point3<f64>], ball_radius_mm: f64) -> Option<Gap> {
     match &motion.scan {
         Scan::Curve(_) => curve_gap(motion, centres, ball_radius_mm),
-        Scan::InPlane(scan) => teach_gap(motion, centres, scan.step, scan.stop_diameter),
+        Scan::InPlane(scan) => teach_gap(
+            motion,
+            centres,
+            scan.spacing.max_distance(),
+            scan.stop_diameter,
+        ),
     }
 }
 

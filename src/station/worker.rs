@@ -827,7 +827,7 @@ impl Worker {
         };
         let rate = MoveReportRate {
             interval: TRAIL_INTERVAL,
-            distance: plan.step,
+            distance: plan.spacing.max_distance(),
         };
         match reporting.start_move_reports(rate).await {
             Ok(reports) => {

@@ -8,7 +8,7 @@ use futures::StreamExt;
 use nalgebra::{Point2, Point3, Vector3};
 use zeroset_drivers::client::Client;
 use zeroset_drivers::machine::{
-    ErrorKind, Event, InPlaneScan, Machine, ScanPoint, TransportError, Xyz,
+    ErrorKind, Event, InPlaneScan, InPlaneSpacing, Machine, ScanPoint, TransportError, Xyz,
 };
 use zeroset_sim::part::curve::SampledCurve;
 
@@ -50,7 +50,7 @@ fn blade_a_section_scan() -> (InPlaneScan, Point3<f64>) {
         start_normal: Xyz::new(0.0, 0.0, 1.0),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: xyz(&(top + Vector3::y() * 10.0)),
-        step: 1.0,
+        spacing: InPlaneSpacing::Step(1.0),
         end: xyz(&(top + Vector3::z())),
         stop_diameter: 3.0,
         passes: 1,

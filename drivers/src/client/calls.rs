@@ -1,7 +1,9 @@
 //! The I++ calls (command lines without their tags) for the station's operations.
 
 use crate::codec::MAX_LINE_LEN;
-use crate::machine::{CurveScan, Density, InPlaneScan, MoveReportRate, Speeds, Xyz};
+use crate::machine::{
+    CurveScan, Density, InPlaneScan, InPlaneSpacing, MoveReportRate, Speeds, Xyz,
+};
 use crate::wire::{Arg, Call, EventTag, Keyword, Name, Number, WireError, WireString};
 
 /// The values of one scan point in the format [`on_scan_report`] asks for.
@@ -71,7 +73,11 @@ pub(crate) fn scan_in_plane(plan: &InPlaneScan) -> Result<Call, WireError> {
     ] {
         values.extend(xyz(point));
     }
-    values.push(plan.step);
+    // Spec 11.3.1.1: StepW 0 asks the machine for ScanUnknownDensity's spacing.
+    values.push(match plan.spacing {
+        InPlaneSpacing::Step(step) => step,
+        InPlaneSpacing::Spacing { .. } => 0.0,
+    });
     values.extend(xyz(plan.end));
     values.push(plan.stop_diameter);
     values.push(f64::from(plan.passes));
@@ -80,6 +86,25 @@ pub(crate) fn scan_in_plane(plan: &InPlaneScan) -> Result<Call, WireError> {
         known_name("ScanInPlaneEndIsSphere"),
         numbers(&values)?,
     ))
+}
+
+/// `ScanUnknownDensity(Dis(..), Angle(..))`, the angle in degrees (as `ScanOnCurveDensity`'s), for an
+/// in-plane scan spaced by distance and turn; none for one spaced by `StepW`.
+pub(crate) fn scan_unknown_density(plan: &InPlaneScan) -> Option<Result<Call, WireError>> {
+    let InPlaneSpacing::Spacing {
+        max_distance,
+        max_angle,
+    } = plan.spacing
+    else {
+        return None;
+    };
+    let args = || {
+        Ok(vec![
+            property("Dis", numbers(&[max_distance])?),
+            property("Angle", numbers(&[max_angle.to_degrees()])?),
+        ])
+    };
+    Some(args().map(|args| Call::new(known_name("ScanUnknownDensity"), args)))
 }
 
 /// `ScanOnCurveHint(Deviation, MinRadiusOfCurvature)`.
@@ -236,7 +261,7 @@ mod tests {
             start_normal: Xyz::new(0.0, 0.0, 1.0),
             plane_normal: Xyz::new(1.0, 0.0, 0.0),
             direction: Xyz::new(0.0, 1.0, 0.0),
-            step: 0.5,
+            spacing: InPlaneSpacing::Step(0.5),
             end: Xyz::new(0.0, 9.0, 0.0),
             stop_diameter: 1.4,
             passes: 1,
@@ -245,6 +270,23 @@ mod tests {
         assert_eq!(
             scan_in_plane(&plan).unwrap().to_string(),
             "ScanInPlaneEndIsSphere(0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0.5, 0, 9, 0, 1.4, 1, 0, 0, 1)"
+        );
+        assert!(scan_unknown_density(&plan).is_none());
+        // Spaced by distance and turn: the density first, then the scan with StepW 0.
+        let spaced = InPlaneScan {
+            spacing: InPlaneSpacing::Spacing {
+                max_distance: 1.0,
+                max_angle: 10f64.to_radians(),
+            },
+            ..plan
+        };
+        assert_eq!(
+            scan_unknown_density(&spaced).unwrap().unwrap().to_string(),
+            "ScanUnknownDensity(Dis(1), Angle(10))"
+        );
+        assert_eq!(
+            scan_in_plane(&spaced).unwrap().to_string(),
+            "ScanInPlaneEndIsSphere(0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 9, 0, 1.4, 1, 0, 0, 1)"
         );
     }
 

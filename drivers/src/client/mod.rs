@@ -320,8 +320,11 @@ impl Machine for Client {
 #[async_trait]
 impl Scanning for Client {
     async fn scan_in_plane(&self, plan: InPlaneScan) -> Result<ScanStream, Error> {
+        let density = calls::scan_unknown_density(&plan)
+            .map(|call| self.call(call, "ScanUnknownDensity"))
+            .transpose()?;
         let scan = self.call(calls::scan_in_plane(&plan), "ScanInPlaneEndIsSphere")?;
-        self.scan(Vec::new(), scan).await
+        self.scan(density.into_iter().collect(), scan).await
     }
 
     async fn scan_on_curve(&self, plan: CurveScan) -> Result<ScanStream, Error> {

@@ -21,7 +21,8 @@ pub use error::{Error, ErrorKind, TransportError};
 pub use event::Event;
 pub use stream::{MoveReports, ScanStream};
 pub use types::{
-    CurveScan, Density, InPlaneScan, MeasuredPoint, MoveReportRate, Nominal, ScanPoint, Speeds, Xyz,
+    CurveScan, Density, InPlaneScan, InPlaneSpacing, MeasuredPoint, MoveReportRate, Nominal,
+    ScanPoint, Speeds, Xyz,
 };
 
 /// A coordinate measuring machine.

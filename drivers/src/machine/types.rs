@@ -60,8 +60,8 @@ pub struct InPlaneScan {
     pub plane_normal: Xyz,
     /// A point that gives the direction of travel from `start`; must differ from `start`.
     pub direction: Xyz,
-    /// Average distance between reported points.
-    pub step: f64,
+    /// Which points the machine reports.
+    pub spacing: InPlaneSpacing,
     pub end: Xyz,
     pub stop_diameter: f64,
     /// On which entry into the stop sphere the scan ends: 1 for a closed profile ending where it
@@ -69,6 +69,28 @@ pub struct InPlaneScan {
     pub passes: u32,
     /// The surface normal at `end`: the direction of the retract.
     pub end_normal: Xyz,
+}
+
+/// How densely an in-plane scan reports points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InPlaneSpacing {
+    /// A point every `step` mm on average (I++'s `StepW`).
+    Step(f64),
+    /// A point at least every `max_distance` mm, and wherever the path turns by more than `max_angle`
+    /// radians (I++'s `ScanUnknownDensity(Dis(..), Angle(..))`, sent before the scan, with `StepW` 0): a
+    /// small radius (a blade's nose, a ball rolling round a sharp edge) gets points as densely as its turn
+    /// asks, not one per step.
+    Spacing { max_distance: f64, max_angle: f64 },
+}
+
+impl InPlaneSpacing {
+    /// The longest distance between reported points, mm (the average one for `Step`).
+    pub fn max_distance(&self) -> f64 {
+        match *self {
+            InPlaneSpacing::Step(step) => step,
+            InPlaneSpacing::Spacing { max_distance, .. } => max_distance,
+        }
+    }
 }
 
 /// A profile scanned along its known nominal (I++ `ScanOnCurve`, with `ScanOnCurveHint` and

@@ -30,7 +30,7 @@ use args::{
     call, call_number, data_calls, report_items, value_call, Item, ALL_ITEMS, POSITION_ITEMS,
 };
 use errors::{code, error_line, needs_clear};
-use motion::{Armed, CurveScanSettings, Plan, World};
+use motion::{Armed, CurveScanSettings, Plan, UnknownScanSettings, World};
 use properties::Properties;
 
 /// The DME version this server implements.
@@ -88,6 +88,7 @@ pub struct Controller {
     pt_report: Vec<Item>,
     scan_report: Vec<Item>,
     curve_scan: CurveScanSettings,
+    unknown_scan: UnknownScanSettings,
     /// An error of severity >= 2, an abort or an emergency stop happened: ClearAllErrors is needed.
     in_error: bool,
     armed: Armed,
@@ -124,6 +125,7 @@ impl Controller {
             pt_report: POSITION_ITEMS.to_vec(),
             scan_report: vec![Item::X, Item::Y, Item::Z, Item::Q],
             curve_scan: CurveScanSettings::default(),
+            unknown_scan: UnknownScanSettings::default(),
             in_error: false,
             armed: Armed::default(),
             queue: VecDeque::new(),
@@ -410,6 +412,7 @@ impl Controller {
                 self.pt_report = POSITION_ITEMS.to_vec();
                 self.scan_report = vec![Item::X, Item::Y, Item::Z, Item::Q];
                 self.curve_scan = CurveScanSettings::default();
+                self.unknown_scan = UnknownScanSettings::default();
                 return done(vec![]);
             }
             "EndSession" => {
@@ -496,6 +499,10 @@ impl Controller {
                 Ok(()) => done(vec![]),
                 Err(code) => fail(code),
             },
+            "ScanUnknownDensity" => match self.set_unknown_density(args) {
+                Ok(()) => done(vec![]),
+                Err(code) => fail(code),
+            },
             "StopDaemon" => match args {
                 [Arg::EventTag(event)]
                     if self.daemon.as_ref().map(|d| d.tag) == Some(Tag::Event(*event)) =>
@@ -558,6 +565,7 @@ impl Controller {
             pt_report: &self.pt_report,
             scan_report: &self.scan_report,
             curve_scan: self.curve_scan,
+            unknown_scan: self.unknown_scan,
         }
     }
 
@@ -646,6 +654,26 @@ impl Controller {
             }
         }
         self.curve_scan = settings;
+        Ok(())
+    }
+
+    /// ScanUnknownDensity(Dis(..), Angle(..)), either or both (spec 11.3.1.1; the angle in degrees, as
+    /// ScanOnCurveDensity's).
+    fn set_unknown_density(&mut self, args: &[Arg]) -> Result<(), u16> {
+        if args.is_empty() {
+            return Err(code::INCORRECT_ARGUMENTS);
+        }
+        let mut settings = self.unknown_scan;
+        for arg in args {
+            let asked = call(arg).ok_or(code::INCORRECT_ARGUMENTS)?;
+            let value = call_number(asked)?;
+            match asked.name.as_str() {
+                "Dis" if value > 0.0 => settings.max_distance = value,
+                "Angle" if value > 0.0 => settings.max_angle_deg = value,
+                _ => return Err(code::BAD_ARGUMENT),
+            }
+        }
+        self.unknown_scan = settings;
         Ok(())
     }
 }

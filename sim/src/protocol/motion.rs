@@ -10,7 +10,7 @@ use super::errors::{code, error_line};
 use super::properties::Properties;
 use crate::kinematics::{Limits, Trajectory};
 use crate::part::{Part, Plane};
-use crate::probe::{first_touch, plane_scan, Contact, Probe, StopSphere};
+use crate::probe::{first_touch, plane_scan, Contact, Probe, Spacing, StopSphere};
 
 /// Scan points per data line: the spec allows blocking them (11.1.2), and long lines keep the share of the
 /// line that carries point data high.
@@ -55,6 +55,22 @@ impl Default for CurveScanSettings {
     }
 }
 
+/// ScanUnknownDensity: the spacing of an unknown-contour scan sent with `StepW` 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnknownScanSettings {
+    pub max_distance: f64,
+    pub max_angle_deg: f64,
+}
+
+impl Default for UnknownScanSettings {
+    fn default() -> Self {
+        UnknownScanSettings {
+            max_distance: 1.0,
+            max_angle_deg: 10.0,
+        }
+    }
+}
+
 /// What a motion needs of the machine.
 pub struct World<'a> {
     pub part: &'a dyn Part,
@@ -66,6 +82,7 @@ pub struct World<'a> {
     pub pt_report: &'a [Item],
     pub scan_report: &'a [Item],
     pub curve_scan: CurveScanSettings,
+    pub unknown_scan: UnknownScanSettings,
 }
 
 impl World<'_> {
@@ -350,7 +367,7 @@ pub fn scan_in_plane(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
         Err(code) => return timeline.fail(code),
     };
     let sane = (d - s).norm() > 0.0
-        && step > 0.0
+        && step >= 0.0
         && diameter > 0.0
         && count >= 1.0
         && count.fract() == 0.0;
@@ -373,7 +390,19 @@ pub fn scan_in_plane(tag: Tag, start: Point3<f64>, args: &[Arg], world: &mut Wor
         radius: diameter / 2.0,
         count: count as u32,
     };
-    let mut contacts = match plane_scan(&section, world.radius, contact.centre, d, step, stop) {
+    // Spec 11.3.1.1: StepW 0 asks for ScanUnknownDensity's spacing.
+    let spacing = if step > 0.0 {
+        Spacing {
+            max_distance: step,
+            max_angle: None,
+        }
+    } else {
+        Spacing {
+            max_distance: world.unknown_scan.max_distance,
+            max_angle: Some(world.unknown_scan.max_angle_deg.to_radians()),
+        }
+    };
+    let mut contacts = match plane_scan(&section, world.radius, contact.centre, d, spacing, stop) {
         Ok(contacts) => contacts,
         Err(_) => return timeline.fail(code::ERROR_PROCESSING_METHOD),
     };

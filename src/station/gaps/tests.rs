@@ -2,7 +2,7 @@
 //! its sharp trailing edge (the real blade 0.4 mm off the nominal, as blade B), and in a teach scan.
 
 use nalgebra::{Point3, Vector3};
-use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, Xyz};
+use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, InPlaneSpacing, Xyz};
 use zeroset_sim::naca::Naca4;
 
 use super::*;
@@ -141,7 +141,7 @@ fn teach_motion() -> ScanMotion {
         start_normal: xyz(0.0, 0.0, 1.0),
         plane_normal: xyz(1.0, 0.0, 0.0),
         direction: xyz(100.0, 1.0, 20.0),
-        step: 1.0,
+        spacing: InPlaneSpacing::Step(1.0),
         end: xyz(100.0, 0.0, 20.0),
         stop_diameter: 3.0,
         passes: 1,

@@ -8,8 +8,8 @@ use futures::stream;
 use nalgebra::Point3;
 use tokio::sync::{broadcast, mpsc};
 use zeroset_drivers::machine::{
-    CurveScan, Density, InPlaneScan, MockMachine, MockMoveReporting, MockScanning, MoveReporting,
-    MoveReports, Nominal, ScanPoint, ScanStream, Scanning, Xyz,
+    CurveScan, Density, InPlaneScan, InPlaneSpacing, MockMachine, MockMoveReporting, MockScanning,
+    MoveReporting, MoveReports, Nominal, ScanPoint, ScanStream, Scanning, Xyz,
 };
 
 use super::*;
@@ -686,7 +686,7 @@ fn teach_motion(towards_y: f64) -> ScanMotion {
         start_normal: xyz(0.0, 0.0, 1.0),
         plane_normal: xyz(1.0, 0.0, 0.0),
         direction: xyz(100.0, towards_y, 20.0),
-        step: 2.0,
+        spacing: InPlaneSpacing::Step(2.0),
         end: xyz(100.0, 0.0, 20.0),
         stop_diameter: 3.0,
         passes: 1,

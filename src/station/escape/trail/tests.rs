@@ -4,7 +4,7 @@
 use super::*;
 use crate::geometry::sweep::closest::closest_between_segments;
 use crate::station::escape::{way_out, EscapeError};
-use zeroset_drivers::machine::Xyz;
+use zeroset_drivers::machine::{InPlaneSpacing, Xyz};
 
 const RADIUS_MM: f64 = 0.5;
 const MARGIN_MM: f64 = 5.0;
@@ -84,7 +84,7 @@ fn plan() -> InPlaneScan {
         start_normal: Xyz::new(n.x, n.y, n.z),
         plane_normal: Xyz::new(1.0, 0.0, 0.0),
         direction: Xyz::new(100.0, 1.0, 1.0 - 1.0 / 40.0),
-        step: 1.0,
+        spacing: InPlaneSpacing::Step(1.0),
         end: Xyz::new(100.0, 0.0, 1.0),
         stop_diameter: 3.0,
         passes: 1,
