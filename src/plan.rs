@@ -4,12 +4,13 @@
 //! are given in the part frame of the master; the plan moves them onto each instance and into machine
 //! coordinates, so the scheduler and the machine workers only ever see machine coordinates.
 
-use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Isometry3, Point3, Unit, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, InPlaneSpacing, Nominal, Xyz};
 
 use crate::analysis::edges::SharpEdge;
 use crate::analysis::reference::Reference;
+use crate::analysis::rolls::rolling;
 use crate::analysis::section::BestFitSettings;
 use crate::analysis::NominalPoint;
 use crate::config::{
@@ -28,6 +29,12 @@ const HEADING_POINT_MM: f64 = 10.0;
 
 /// Nominals closer than this to a neighbour are one point of a sharp edge that the ball rolled around, mm.
 const EDGE_POINT_MM: f64 = 0.05;
+
+/// A curve scan starts at least this far from a sharp edge, mm, where the profile leaves room: the compensation
+/// of a roll round the edge looks back along the centres before it (up to 24 of them), which a scan that has
+/// just started does not have. Blade B's r500 scans, started on the face 0.7 mm before the trailing edge (its
+/// last nominal there points most nearly up), read the edge's contacts up to 45 um apart and the chord 37 um long.
+const START_CLEAR_OF_EDGE_MM: f64 = 15.0;
 
 /// One scan of the plan: an instance's profile (indices into [`Plan::instance_names`] and
 /// [`Plan::profile_names`]). Ordered by instance, then profile.
@@ -191,7 +198,13 @@ impl Plan {
             start_normal: direction(normal),
             plane_normal: xyz(&self.plane_normal(key.instance)),
             direction: point(start + heading * HEADING_POINT_MM),
-            spacing: InPlaneSpacing::Step(self.part.scan.step_mm),
+            // As densely round the master's nose as the inspections' curve scans (its nominal's tip is fitted to
+            // the points there, and the chord's nominal with it), and its rolls round sharp edges in the steps of
+            // the scan's `max_angle_deg` or finer (the taught rolls are thinned again, see `reference`).
+            spacing: InPlaneSpacing::Spacing {
+                max_distance: self.part.scan.step_mm,
+                max_angle: self.part.scan.finest_angle_deg().to_radians(),
+            },
             end: point(start + normal * STOP_CENTRE_OFF_START_MM),
             stop_diameter: self.part.scan.stop_diameter_mm,
             passes: 1,
@@ -218,13 +231,9 @@ impl Plan {
             self.upmost(key, nominals)
         };
         let in_order = || nominals[first..].iter().chain(&nominals[..first]);
+        let apexes: Vec<[f64; 2]> = sharp_edges.iter().map(|edge| edge.apex).collect();
         let rolling: Vec<bool> = in_order()
-            .map(|n| {
-                sharp_edges.iter().any(|edge| {
-                    (Vector2::new(n.point[1], n.point[2]) - Vector2::from(edge.apex)).norm()
-                        <= ROLL_REACH_MM
-                })
-            })
+            .map(|n| rolling(&Point3::from(n.point), &apexes))
             .collect();
         let nominals: Vec<Nominal> = in_order()
             .map(|n| Nominal {
@@ -234,9 +243,7 @@ impl Plan {
             .collect();
         let scan = &self.part.scan;
         let angle = scan.max_angle_deg.to_radians();
-        let round_edge_angle = scan
-            .round_edge_max_angle_deg
-            .map_or(angle, |a| a.to_radians().min(angle));
+        let round_edge_angle = scan.finest_angle_deg().to_radians();
         let max_angle = |i: usize, j: usize| {
             if rolling[i] || rolling[j] {
                 angle
@@ -299,7 +306,8 @@ impl Plan {
     ///
     /// Nominals on a sharp edge are passed over (where the taught ball rolled around an edge, one point carries a
     /// fan of normals, one of them straight up): a scan that starts on an edge approaches a tip, and sends its
-    /// hardest points to the analysis in one burst (seen as a 3 ms p99 latency of deviation events).
+    /// hardest points to the analysis in one burst (seen as a 3 ms p99 latency of deviation events). So are those
+    /// within [`START_CLEAR_OF_EDGE_MM`] of one, where the profile has others.
     fn upmost(&self, key: ProfileKey, nominals: &[NominalPoint]) -> usize {
         let placement = self.instance_to_machine(key.instance);
         let upness = |n: &NominalPoint| (placement * Vector3::from(n.normal)).normalize().z;
@@ -310,12 +318,27 @@ impl Plan {
                 .iter()
                 .any(|&j| j != i && (Point3::from(nominals[j].point) - here).norm() < EDGE_POINT_MM)
         };
-        let candidates: Vec<usize> = (0..count).filter(|&i| !on_edge(i)).collect();
-        let candidates = if candidates.is_empty() {
-            (0..count).collect()
-        } else {
-            candidates
+        let edges: Vec<Point3<f64>> = (0..count)
+            .filter(|&i| on_edge(i))
+            .map(|i| Point3::from(nominals[i].point))
+            .collect();
+        let clear_of_edges = |i: usize| {
+            let here = Point3::from(nominals[i].point);
+            edges
+                .iter()
+                .all(|edge| (edge - here).norm() >= START_CLEAR_OF_EDGE_MM)
         };
+        // Clear of every edge where the profile leaves room; else off the edges at least; else anywhere.
+        let candidates = [
+            (0..count)
+                .filter(|&i| clear_of_edges(i))
+                .collect::<Vec<_>>(),
+            (0..count).filter(|&i| !on_edge(i)).collect(),
+            (0..count).collect(),
+        ]
+        .into_iter()
+        .find(|c| !c.is_empty())
+        .expect("the nominals are not empty");
         candidates.into_iter().fold(usize::MAX, |best, i| {
             if best == usize::MAX || upness(&nominals[i]) > upness(&nominals[best]) {
                 i
@@ -448,10 +471,6 @@ fn at_density(
     }
     out
 }
-
-/// A taught nominal this close to a sharp edge's apex, in its profile's plane (mm), is one of the contacts of the
-/// ball rolling round the edge: the compensation finds those within about 12 um of the apex.
-const ROLL_REACH_MM: f64 = 0.1;
 
 fn xyz(v: &Vector3<f64>) -> Xyz {
     Xyz::new(v.x, v.y, v.z)

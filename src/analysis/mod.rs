@@ -10,6 +10,7 @@ pub(crate) mod fit_sanity;
 mod nominals;
 pub mod part_mesh;
 pub mod reference;
+pub(crate) mod rolls;
 pub mod section;
 pub mod stats;
 #[cfg(test)]

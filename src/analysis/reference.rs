@@ -13,6 +13,7 @@ pub use self::file::ReferenceFileError;
 use super::edges::{find_sharp_edges, SharpEdge};
 use super::nominals::thin_to_nominals;
 pub use super::nominals::NominalPoint;
+use super::rolls::{with_rolls_merged, without_dense_rolls};
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitError, FitMethod, FitOptions, FitStats, Fitted};
 use crate::geometry::interp::StackError;
@@ -197,6 +198,37 @@ pub fn teach(
             });
         }
     }
+    // The sharp edges, found in the whole scans. The polynomials are fitted to every point, the faces to each roll
+    // round an edge as one point, and the nominals are thinned from the scans with each roll thinned first (see
+    // `rolls`).
+    let with_edges = matches!(settings, ReferenceSettings::ImplicitPolynomial { .. });
+    let edges: Vec<Vec<SharpEdge>> = profiles
+        .iter()
+        .map(|p| {
+            if with_edges {
+                profile_edges(p)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    let apexes: Vec<Vec<[f64; 2]>> = edges
+        .iter()
+        .map(|edges| edges.iter().map(|e| e.apex).collect())
+        .collect();
+    let merged: Vec<MasterProfile> = profiles
+        .iter()
+        .zip(&apexes)
+        .map(|(p, apexes)| {
+            let (points, normals) = with_rolls_merged(&p.points, &p.normals, apexes);
+            MasterProfile {
+                name: p.name.clone(),
+                x_mm: p.x_mm,
+                points,
+                normals,
+            }
+        })
+        .collect();
     let (model, method) = match *settings {
         ReferenceSettings::ImplicitPolynomial { degree, method, .. } => (
             fit_stack(profiles, &FitOptions::new(degree, method))?,
@@ -207,10 +239,9 @@ pub fn teach(
             "superformula prism: Levenberg-Marquardt on the radial residual (mm)".to_string(),
         ),
     };
-    let with_edges = matches!(model, ReferenceModel::Stack { .. });
     let faces: Vec<Option<FacedIp>> = if let ReferenceModel::Stack { profiles: fitted } = &model {
         std::thread::scope(|scope| {
-            let fits: Vec<_> = profiles
+            let fits: Vec<_> = merged
                 .iter()
                 .zip(fitted)
                 .map(|(profile, fitted)| {
@@ -230,16 +261,19 @@ pub fn teach(
     let taught = profiles
         .iter()
         .zip(faces)
-        .map(|(p, faces)| ReferenceProfile {
-            name: p.name.clone(),
-            x_mm: p.x_mm,
-            nominals: thin_to_nominals(&p.points, &p.normals, spacing_mm),
-            edges: if with_edges {
-                profile_edges(p)
-            } else {
-                Vec::new()
-            },
-            faces,
+        .zip(edges)
+        .zip(&apexes)
+        .map(|(((p, faces), edges), apexes)| {
+            let kept = without_dense_rolls(&p.points, &p.normals, apexes);
+            let points: Vec<_> = kept.iter().map(|&i| p.points[i]).collect();
+            let normals: Vec<_> = kept.iter().map(|&i| p.normals[i]).collect();
+            ReferenceProfile {
+                name: p.name.clone(),
+                x_mm: p.x_mm,
+                nominals: thin_to_nominals(&points, &normals, spacing_mm),
+                edges,
+                faces,
+            }
         })
         .collect();
     Ok(Reference {

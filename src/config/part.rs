@@ -75,7 +75,7 @@ pub struct ProfileEntry {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ScanSettings {
-    /// Distance between scan points (teach) and the longest gap between curve-scan points (inspect).
+    /// The longest gap between scan points, teach and inspect.
     pub step_mm: f64,
     /// The sphere around the start that ends a teach scan when the probe comes back into it.
     pub stop_diameter_mm: f64,
@@ -85,10 +85,10 @@ pub struct ScanSettings {
     pub min_radius_mm: f64,
     /// A curve scan reports a point wherever the path turns by more than this.
     pub max_angle_deg: f64,
-    /// Round the tight curves of a profile (a blade's round nose) a curve scan reports a point wherever the path
-    /// turns by more than this instead, where it is smaller: a round edge's tip is fitted to the points within 50
-    /// deg of it, and more points there average more of the probe's noise. A sharp edge's roll keeps
-    /// `max_angle_deg`. Absent: `max_angle_deg` everywhere.
+    /// Round the tight curves of a profile (a blade's round nose) a scan reports a point wherever the path turns
+    /// by more than this instead, where it is smaller: a round edge's tip is fitted to the points within 50 deg of
+    /// it, and more points there average more of the probe's noise, on the master (teach) as on each instance. A
+    /// sharp edge's roll keeps `max_angle_deg`. Absent: `max_angle_deg` everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub round_edge_max_angle_deg: Option<f64>,
 }
@@ -299,6 +299,12 @@ impl ProfileEntry {
 }
 
 impl ScanSettings {
+    /// The finest turn between scan points asked for: round the round edges, where one is given (deg).
+    pub(crate) fn finest_angle_deg(&self) -> f64 {
+        self.round_edge_max_angle_deg
+            .map_or(self.max_angle_deg, |a| a.min(self.max_angle_deg))
+    }
+
     fn check(&self) -> Result<(), String> {
         let positive = [
             ("step_mm", self.step_mm),

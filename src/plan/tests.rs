@@ -174,9 +174,13 @@ fn the_teach_scan_of_blade_a_starts_on_the_simulated_surface_in_the_plane_x() {
     assert_near(&scan.direction, [200.0, 10.0, 16.34], "direction point");
     assert_near(&scan.end, [200.0, 0.0, 17.34], "end");
     assert_near(&scan.end_normal, [0.0, 0.0, 1.0], "end normal");
+    assert_eq!((scan.stop_diameter, scan.passes), (3.0, 1));
     assert_eq!(
-        (scan.spacing, scan.stop_diameter, scan.passes),
-        (InPlaneSpacing::Step(1.0), 3.0, 1)
+        scan.spacing,
+        InPlaneSpacing::Spacing {
+            max_distance: 1.0,
+            max_angle: 10f64.to_radians()
+        }
     );
 }
 
@@ -253,6 +257,43 @@ fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
     let start = plan.scan_start(key(0, 1), Some(&nominals));
     assert!(
         (start - Point3::new(200.0, 0.0, 30.0)).norm() < 1e-9,
+        "{start}"
+    );
+}
+
+#[test]
+fn a_curve_scan_starts_clear_of_a_sharp_edge_where_the_profile_leaves_room() {
+    // A thin section in the plane x = 200: its upper face (z = 1, every 2 mm from y = -40 to 38) leans so that
+    // its normal points most nearly up at y = 38, 2 mm before the sharp edge at y = 40 (three nominals at one
+    // point, a fan of normals). The scan starts at the most upward normal 15 mm or more from the edge: y = 24.
+    let normal = |y: f64, z: f64| {
+        let n = Vector3::new(0.0, y, z).normalize();
+        [n.x, n.y, n.z]
+    };
+    let mut nominals: Vec<NominalPoint> = (0..40)
+        .map(|k| {
+            let y = -40.0 + 2.0 * k as f64;
+            NominalPoint {
+                point: [200.0, y, 1.0],
+                normal: normal(0.01 * (y - 38.0), 1.0),
+            }
+        })
+        .collect();
+    nominals.extend([30.0f64, 90.0, 150.0].map(|deg| NominalPoint {
+        point: [200.0, 40.0, 0.0],
+        normal: normal(deg.to_radians().sin(), deg.to_radians().cos()),
+    }));
+    nominals.extend((0..40).map(|k| NominalPoint {
+        point: [200.0, 38.0 - 2.0 * k as f64, -1.0],
+        normal: [0.0, 0.0, -1.0],
+    }));
+    nominals.push(NominalPoint {
+        point: [200.0, -41.0, 0.0],
+        normal: [0.0, -1.0, 0.0],
+    });
+    let start = plan().scan_start(key(0, 1), Some(&nominals));
+    assert!(
+        (start - Point3::new(200.0, 24.0, 1.0)).norm() < 1e-9,
         "{start}"
     );
 }
