@@ -128,6 +128,10 @@ fn a_lost_line_of_points_is_a_gap_wherever_it_was_lost() {
 }
 
 fn teach_motion() -> ScanMotion {
+    teach_motion_spaced(InPlaneSpacing::Step(1.0))
+}
+
+fn teach_motion_spaced(spacing: InPlaneSpacing) -> ScanMotion {
     let start = Point3::new(100.0, 0.0, 20.0);
     let path = KnownPath {
         surface: vec![start],
@@ -141,7 +145,7 @@ fn teach_motion() -> ScanMotion {
         start_normal: xyz(0.0, 0.0, 1.0),
         plane_normal: xyz(1.0, 0.0, 0.0),
         direction: xyz(100.0, 1.0, 20.0),
-        spacing: InPlaneSpacing::Step(1.0),
+        spacing,
         end: xyz(100.0, 0.0, 20.0),
         stop_diameter: 3.0,
         passes: 1,
@@ -166,6 +170,95 @@ fn a_teach_scan_is_whole_when_its_steps_are_and_it_closes() {
     assert_eq!(find_gap(&motion, &holed, BALL).unwrap().after, Some(59));
     let cut = &whole[..turn - 10];
     assert_eq!(find_gap(&motion, cut, BALL).unwrap().after, Some(turn - 11));
+}
+
+/// The ball centres (plane x = 100, (y, z) mm) of a teach scan spaced by 1 mm and 2.5 deg round the polygon
+/// `corners` (clockwise seen from +x, so the scan goes round the part the one way), rolling round each convex
+/// corner and leaving one face for the next at once at a concave one, with 2 um of seeded noise.
+fn spaced_teach_centres(corners: &[[f64; 2]]) -> Vec<Point3<f64>> {
+    let n = corners.len();
+    let v = |i: usize| nalgebra::Vector2::from(corners[i % n]);
+    let along = |i: usize| (v(i + 1) - v(i)).normalize();
+    // Outward normal of a clockwise polygon: the edge's direction turned +90 deg.
+    let out = |i: usize| nalgebra::Vector2::new(-along(i).y, along(i).x);
+    let step_angle = 2.5f64.to_radians();
+    let mut path: Vec<nalgebra::Vector2<f64>> = Vec::new();
+    for i in 0..n {
+        // Each face's centre line runs between where it leaves the corners at its ends.
+        let trim = |before: usize, after: usize| {
+            // A concave corner (turning anticlockwise here): the centre lines meet BALL * tan(half the turn) from
+            // it along each face.
+            if along(before).perp(&along(after)) > 0.0 {
+                BALL * (along(before).angle(&along(after)) / 2.0).tan()
+            } else {
+                0.0
+            }
+        };
+        let (from, to) = (trim(i + n - 1, i), trim(i, i + 1));
+        let length = (v(i + 1) - v(i)).norm() - from - to;
+        let steps = length.ceil() as usize;
+        for k in 0..steps {
+            path.push(v(i) + along(i) * (from + length * k as f64 / steps as f64) + out(i) * BALL);
+        }
+        // Round the next corner, if it is convex (turning clockwise): the ball rolls on its apex.
+        if along(i).perp(&along(i + 1)) < 0.0 {
+            let turn = along(i).angle(&along(i + 1));
+            let steps = (turn / step_angle).ceil() as usize;
+            for k in 0..steps {
+                let a = -turn * k as f64 / steps as f64;
+                path.push(v(i + 1) + nalgebra::Rotation2::new(a) * out(i) * BALL);
+            }
+        }
+    }
+    // Seeded noise, uniform with 2 um standard deviation on each axis.
+    let mut state: u64 = 7;
+    let mut noise = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.002 * 12f64.sqrt()
+    };
+    path.iter()
+        .map(|p| Point3::new(100.0, p.x + noise(), p.y + noise()))
+        .collect()
+}
+
+#[test]
+fn a_teach_scan_spaced_by_turn_is_a_gap_where_points_are_lost_round_a_roll_and_not_at_a_concave_corner(
+) {
+    let spaced = teach_motion_spaced(InPlaneSpacing::Spacing {
+        max_distance: 1.0,
+        max_angle: 2.5f64.to_radians(),
+    });
+    // A thin plate, 40 x 2 mm, its ends sharp edges the ball rolls round in 72 steps of 2.5 deg (44 um), clockwise
+    // from its top left.
+    let plate = spaced_teach_centres(&[[-20.0, 1.0], [20.0, 1.0], [20.0, -1.0], [-20.0, -1.0]]);
+    assert_eq!(find_gap(&spaced, &plate, BALL), None);
+    // Points lost round the right end's roll (it starts after the 40 points of the top face): a line of ten, and
+    // three. The step's spacing alone (1 mm, the old check) misses the three: 0.18 mm.
+    for lost in [10, 3] {
+        let mut holed = plate.clone();
+        holed.drain(60..60 + lost);
+        assert_eq!(
+            find_gap(&spaced, &holed, BALL).map(|gap| gap.after),
+            Some(Some(59)),
+            "{lost} lost"
+        );
+        if lost == 3 {
+            assert_eq!(find_gap(&teach_motion(), &holed, BALL), None);
+        }
+    }
+    // A step down in the top face: a concave corner (the ball leaves the floor for the wall at once, its centres
+    // turning 90 deg the other way with no point between) and a convex one it rolls round.
+    let stepped = spaced_teach_centres(&[
+        [-20.0, 1.0],
+        [0.0, 1.0],
+        [0.0, 3.0],
+        [20.0, 3.0],
+        [20.0, -1.0],
+        [-20.0, -1.0],
+    ]);
+    assert_eq!(find_gap(&spaced, &stepped, BALL), None);
 }
 
 #[test]
