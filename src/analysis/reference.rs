@@ -197,6 +197,14 @@ pub fn teach(
                 name: profile.name.clone(),
             });
         }
+        if profile.normals.len() != profile.points.len() {
+            return Err(TeachError::NormalCount {
+                name: profile.name.clone(),
+                x_mm: profile.x_mm,
+                points: profile.points.len(),
+                normals: profile.normals.len(),
+            });
+        }
     }
     // The sharp edges, found in the whole scans. The polynomials are fitted to every point, the faces to each roll
     // round an edge as one point, and the nominals are thinned from the scans with each roll thinned first (see
@@ -360,14 +368,6 @@ fn fit_prism(
 /// normals 3.2, 38, 2.2, 2.0, 1.8; degree 10 with ordered normals 63, 2.4, 2.0, 1.9, 1.8.
 fn fit_profile(profile: &MasterProfile, options: &FitOptions) -> Result<StackProfile, TeachError> {
     let (name, x_mm) = (profile.name.clone(), profile.x_mm);
-    if profile.normals.len() != profile.points.len() {
-        return Err(TeachError::NormalCount {
-            name,
-            x_mm,
-            points: profile.points.len(),
-            normals: profile.normals.len(),
-        });
-    }
     let points: Vec<Vector2<f64>> = profile
         .points
         .iter()

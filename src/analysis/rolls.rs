@@ -1,5 +1,5 @@
 //! The contacts of the ball rolling round a sharp edge in a master's teach scan: which they are, and how the
-//! reference takes them (thinned for the nominals, one point for the faces' fits; the polynomial takes them all).
+//! reference takes them (thinned for the nominals, the apex for the faces' fits; the polynomial takes them all).
 
 use nalgebra::{Point3, Vector3};
 
@@ -57,36 +57,48 @@ pub(crate) fn without_dense_rolls(
 }
 
 /// A master scan (as [`without_dense_rolls`] takes it) with each roll round a sharp edge replaced by one point,
-/// its contacts' mean, with their mean normal: what the faces are fitted to.
+/// the edge's apex (as [`find_sharp_edges`](super::edges::find_sharp_edges) found it: the mean of the contacts
+/// that stayed put while the normal turned), with the contacts' mean normal: what the faces are fitted to.
 ///
 /// Why: the faces already pass through the edge (the sharp end's point weighs `EDGE_WEIGHT` in their fits). A roll
 /// of 60 contacts within the compensation's 12 um of the apex, split between the two faces, outweighed their
-/// other points: r400's faces read the trailing edge 25 um thick, r300's fitted their points 3.4 um RMS.
+/// other points: r400's faces read the trailing edge 25 um thick, r300's fitted their points 3.4 um RMS. The apex,
+/// not the mean of every point within [`ROLL_REACH_MM`]: points sampled along the faces up to a sharp edge (no
+/// ball rolling) lie within that reach too, and their mean lies inside the edge.
 pub(crate) fn with_rolls_merged(
     points: &[Point3<f64>],
     normals: &[Vector3<f64>],
     apexes: &[[f64; 2]],
 ) -> (Vec<Point3<f64>>, Vec<Vector3<f64>>) {
-    let rolling = |i: usize| rolling(&points[i], apexes);
+    let nearest_apex = |p: &Point3<f64>| {
+        apexes
+            .iter()
+            .min_by(|a, b| {
+                let off = |a: &[f64; 2]| (a[0] - p.y).hypot(a[1] - p.z);
+                off(a).total_cmp(&off(b))
+            })
+            .copied()
+    };
     let mut merged_points = Vec::with_capacity(points.len());
     let mut merged_normals = Vec::with_capacity(points.len());
     let mut i = 0;
     while i < points.len() {
+        let apex = nearest_apex(&points[i]).filter(|_| rolling(&points[i], apexes));
+        let Some(apex) = apex else {
+            merged_points.push(points[i]);
+            merged_normals.push(normals[i]);
+            i += 1;
+            continue;
+        };
         let mut end = i + 1;
-        if rolling(i) {
-            while end < points.len() && rolling(end) {
-                end += 1;
-            }
+        while end < points.len() && rolling(&points[end], apexes) {
+            end += 1;
         }
-        let count = (end - i) as f64;
-        let mean = points[i..end]
-            .iter()
-            .fold(Vector3::zeros(), |sum, p| sum + p.coords)
-            / count;
+        let x = points[i..end].iter().map(|p| p.x).sum::<f64>() / (end - i) as f64;
         let normal = normals[i..end]
             .iter()
             .fold(Vector3::zeros(), |sum, n| sum + n.normalize());
-        merged_points.push(Point3::from(mean));
+        merged_points.push(Point3::new(x, apex[0], apex[1]));
         merged_normals.push(if normal.norm() > 0.0 {
             normal.normalize()
         } else {
@@ -129,9 +141,9 @@ mod tests {
     }
 
     #[test]
-    fn a_roll_becomes_its_contacts_mean_and_the_faces_are_kept_as_they_are() {
+    fn a_roll_becomes_its_edges_apex_and_the_faces_are_kept_as_they_are() {
         // Two faces meeting at (y, z) = (10, 0): four points on each, and a roll of three contacts between them
-        // (normals up, along +y, down): those become one point at their mean with the normal along +y.
+        // (normals up, along +y, down): those become one point at the apex with the normal along +y.
         let mut points: Vec<Point3<f64>> = (0..4)
             .map(|k| Point3::new(50.0, k as f64 * 2.0, 0.05))
             .collect();
@@ -146,11 +158,7 @@ mod tests {
         assert_eq!(merged.len(), 9);
         assert_eq!(&merged[..4], &points[..4]);
         assert_eq!(&merged[5..], &points[7..]);
-        assert!(
-            (merged[4] - Point3::new(50.0, 10.003, 0.0)).norm() < 1e-12,
-            "{}",
-            merged[4]
-        );
+        assert_eq!(merged[4], Point3::new(50.0, 10.0, 0.0));
         assert!(
             (merged_normals[4] - Vector3::y()).norm() < 1e-12,
             "{}",
