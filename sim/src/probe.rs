@@ -374,33 +374,45 @@ mod tests {
         assert!((rms - 0.002).abs() < 0.0002, "rms {rms}");
     }
 
-    #[test]
-    fn a_plane_scan_goes_once_around_and_stops_in_its_sphere() {
+    /// Where the plane scans round the cylinder start: on its section at z = 5, the ball's centre at (11, 0, 5).
+    const AROUND_START: Point3<f64> = Point3::new(11.0, 0.0, 5.0);
+
+    /// A plane scan round the cylinder (radius 10 mm) at z = 5 with a 1 mm ball, from [`AROUND_START`]
+    /// counter-clockwise, until `stop`.
+    fn around_cylinder(spacing: Spacing, stop: StopSphere) -> Result<Vec<Contact>, PlaneScanError> {
         let section = Cylinder
             .section(&Plane {
                 point: Point3::new(0.0, 0.0, 5.0),
                 normal: Vector3::z(),
             })
             .unwrap();
-        let start = Point3::new(11.0, 0.0, 5.0);
-        let stop = StopSphere {
-            centre: start,
-            radius: 1.5,
+        plane_scan(
+            &section,
+            1.0,
+            AROUND_START,
+            Point3::new(11.0, 5.0, 5.0),
+            spacing,
+            stop,
+        )
+    }
+
+    /// A stop sphere of `radius` round [`AROUND_START`], ending the scan on its first entry.
+    fn stop_round_start(radius: f64) -> StopSphere {
+        StopSphere {
+            centre: AROUND_START,
+            radius,
             count: 1,
-        };
+        }
+    }
+
+    #[test]
+    fn a_plane_scan_goes_once_around_and_stops_in_its_sphere() {
+        let stop = stop_round_start(1.5);
         let every_mm = Spacing {
             max_distance: 1.0,
             max_angle: None,
         };
-        let contacts = plane_scan(
-            &section,
-            1.0,
-            start,
-            Point3::new(11.0, 5.0, 5.0),
-            every_mm,
-            stop,
-        )
-        .unwrap();
+        let contacts = around_cylinder(every_mm, stop).unwrap();
         // Circumference of the centre path 2 pi 11 = 69.1 mm at 1 mm steps: the last is the closest to start.
         assert_eq!(contacts.len(), 70);
         assert!(contacts[1].centre.y > 0.0, "counterclockwise, towards +y");
@@ -411,23 +423,12 @@ mod tests {
             centre: Point3::new(50.0, 0.0, 5.0),
             ..stop
         };
-        assert!(plane_scan(&section, 1.0, start, start, every_mm, never).is_err());
+        assert!(around_cylinder(every_mm, never).is_err());
     }
 
     #[test]
     fn a_plane_scan_spaced_by_turn_reports_a_point_wherever_the_normal_has_turned_that_much() {
-        let section = Cylinder
-            .section(&Plane {
-                point: Point3::new(0.0, 0.0, 5.0),
-                normal: Vector3::z(),
-            })
-            .unwrap();
-        let start = Point3::new(11.0, 0.0, 5.0);
-        let stop = StopSphere {
-            centre: start,
-            radius: 0.7,
-            count: 1,
-        };
+        let stop = stop_round_start(0.7);
         // 3 deg on the centre path of radius 11 mm is 0.58 mm, under the 1 mm distance: the turn sets the
         // spacing, 120 steps round (121 points, the last back at the start, the closest to the stop sphere's
         // centre).
@@ -435,15 +436,7 @@ mod tests {
             max_distance: 1.0,
             max_angle: Some(3f64.to_radians()),
         };
-        let contacts = plane_scan(
-            &section,
-            1.0,
-            start,
-            Point3::new(11.0, 5.0, 5.0),
-            spacing,
-            stop,
-        )
-        .unwrap();
+        let contacts = around_cylinder(spacing, stop).unwrap();
         assert_eq!(contacts.len(), 121);
         for pair in contacts.windows(2) {
             let turned = pair[0]
@@ -462,20 +455,13 @@ mod tests {
             max_distance: 1.0,
             max_angle: None,
         };
-        let (towards, stop) = (
-            Point3::new(11.0, 5.0, 5.0),
-            StopSphere {
-                radius: 1.5,
-                ..stop
-            },
-        );
+        let stop = StopSphere {
+            radius: 1.5,
+            ..stop
+        };
         assert_eq!(
-            plane_scan(&section, 1.0, start, towards, wide, stop)
-                .unwrap()
-                .len(),
-            plane_scan(&section, 1.0, start, towards, by_distance, stop)
-                .unwrap()
-                .len()
+            around_cylinder(wide, stop).unwrap().len(),
+            around_cylinder(by_distance, stop).unwrap().len()
         );
     }
 }

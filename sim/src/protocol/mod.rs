@@ -30,7 +30,7 @@ use args::{
     call, call_number, data_calls, report_items, value_call, Item, ALL_ITEMS, POSITION_ITEMS,
 };
 use errors::{code, error_line, needs_clear};
-use motion::{Armed, CurveScanSettings, Plan, UnknownScanSettings, World};
+use motion::{Armed, CurveScanSettings, Plan, ScanSpacing, World};
 use properties::Properties;
 
 /// The DME version this server implements.
@@ -88,7 +88,7 @@ pub struct Controller {
     pt_report: Vec<Item>,
     scan_report: Vec<Item>,
     curve_scan: CurveScanSettings,
-    unknown_scan: UnknownScanSettings,
+    unknown_scan: ScanSpacing,
     /// An error of severity >= 2, an abort or an emergency stop happened: ClearAllErrors is needed.
     in_error: bool,
     armed: Armed,
@@ -125,7 +125,7 @@ impl Controller {
             pt_report: POSITION_ITEMS.to_vec(),
             scan_report: vec![Item::X, Item::Y, Item::Z, Item::Q],
             curve_scan: CurveScanSettings::default(),
-            unknown_scan: UnknownScanSettings::default(),
+            unknown_scan: ScanSpacing::default(),
             in_error: false,
             armed: Armed::default(),
             queue: VecDeque::new(),
@@ -412,7 +412,7 @@ impl Controller {
                 self.pt_report = POSITION_ITEMS.to_vec();
                 self.scan_report = vec![Item::X, Item::Y, Item::Z, Item::Q];
                 self.curve_scan = CurveScanSettings::default();
-                self.unknown_scan = UnknownScanSettings::default();
+                self.unknown_scan = ScanSpacing::default();
                 return done(vec![]);
             }
             "EndSession" => {
@@ -642,15 +642,11 @@ impl Controller {
     /// ScanOnCurveDensity(Dis(..), Angle(..), AtNominals(..)), any of them.
     fn set_density(&mut self, args: &[Arg]) -> Result<(), u16> {
         let mut settings = self.curve_scan;
-        for arg in args {
-            let asked = call(arg).ok_or(code::INCORRECT_ARGUMENTS)?;
-            let value = call_number(asked)?;
-            match asked.name.as_str() {
-                "Dis" if value > 0.0 => settings.max_distance = value,
-                "Angle" if value > 0.0 => settings.max_angle_deg = value,
-                "AtNominals" => settings.at_nominals = value != 0.0,
-                "Dis" | "Angle" => return Err(code::BAD_ARGUMENT),
-                _ => return Err(code::BAD_ARGUMENT),
+        for (name, value) in density_properties(args)? {
+            match settings.spacing.set(name, value) {
+                Some(set) => set?,
+                None if name == "AtNominals" => settings.at_nominals = value != 0.0,
+                None => return Err(code::BAD_ARGUMENT),
             }
         }
         self.curve_scan = settings;
@@ -663,19 +659,25 @@ impl Controller {
         if args.is_empty() {
             return Err(code::INCORRECT_ARGUMENTS);
         }
-        let mut settings = self.unknown_scan;
-        for arg in args {
-            let asked = call(arg).ok_or(code::INCORRECT_ARGUMENTS)?;
-            let value = call_number(asked)?;
-            match asked.name.as_str() {
-                "Dis" if value > 0.0 => settings.max_distance = value,
-                "Angle" if value > 0.0 => settings.max_angle_deg = value,
-                _ => return Err(code::BAD_ARGUMENT),
-            }
+        let mut spacing = self.unknown_scan;
+        for (name, value) in density_properties(args)? {
+            spacing
+                .set(name, value)
+                .unwrap_or(Err(code::BAD_ARGUMENT))?;
         }
-        self.unknown_scan = settings;
+        self.unknown_scan = spacing;
         Ok(())
     }
+}
+
+/// A density command's arguments as `(name, number)`: each must be a call of one number.
+fn density_properties(args: &[Arg]) -> Result<Vec<(&str, f64)>, u16> {
+    args.iter()
+        .map(|arg| {
+            let asked = call(arg).ok_or(code::INCORRECT_ARGUMENTS)?;
+            Ok((asked.name.as_str(), call_number(asked)?))
+        })
+        .collect()
 }
 
 fn ack(tag: Tag) -> Response {

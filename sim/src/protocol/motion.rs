@@ -36,38 +36,46 @@ pub struct Armed {
 }
 
 /// ScanOnCurveDensity and ScanOnCurveHint.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CurveScanSettings {
-    pub max_distance: f64,
-    pub max_angle_deg: f64,
+    pub spacing: ScanSpacing,
     pub at_nominals: bool,
     pub expected_deviation: f64,
 }
 
-impl Default for CurveScanSettings {
-    fn default() -> Self {
-        CurveScanSettings {
-            max_distance: 1.0,
-            max_angle_deg: 10.0,
-            at_nominals: false,
-            expected_deviation: 0.0,
-        }
-    }
-}
-
-/// ScanUnknownDensity: the spacing of an unknown-contour scan sent with `StepW` 0.
+/// The `Dis` and `Angle` of ScanOnCurveDensity, and of ScanUnknownDensity (the spacing of an unknown-contour
+/// scan sent with `StepW` 0): a point at least every `max_distance` mm and wherever the path turns by
+/// `max_angle_deg`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct UnknownScanSettings {
+pub struct ScanSpacing {
     pub max_distance: f64,
     pub max_angle_deg: f64,
 }
 
-impl Default for UnknownScanSettings {
+impl Default for ScanSpacing {
     fn default() -> Self {
-        UnknownScanSettings {
+        ScanSpacing {
             max_distance: 1.0,
             max_angle_deg: 10.0,
         }
+    }
+}
+
+impl ScanSpacing {
+    /// Sets `Dis` or `Angle` from a density command's `name(value)`, which must be positive; `None` for another
+    /// name.
+    pub fn set(&mut self, name: &str, value: f64) -> Option<Result<(), u16>> {
+        let field = match name {
+            "Dis" => &mut self.max_distance,
+            "Angle" => &mut self.max_angle_deg,
+            _ => return None,
+        };
+        Some(if value > 0.0 {
+            *field = value;
+            Ok(())
+        } else {
+            Err(code::BAD_ARGUMENT)
+        })
     }
 }
 
@@ -82,7 +90,7 @@ pub struct World<'a> {
     pub pt_report: &'a [Item],
     pub scan_report: &'a [Item],
     pub curve_scan: CurveScanSettings,
-    pub unknown_scan: UnknownScanSettings,
+    pub unknown_scan: ScanSpacing,
 }
 
 impl World<'_> {
@@ -569,9 +577,9 @@ fn densify(nominals: &[Nominal], closed: bool, settings: &CurveScanSettings) -> 
         }
         let distance = (b.point - a.point).norm();
         let angle = a.normal.angle(&b.normal).to_degrees();
-        let pieces = (distance / settings.max_distance)
+        let pieces = (distance / settings.spacing.max_distance)
             .ceil()
-            .max((angle / settings.max_angle_deg).ceil())
+            .max((angle / settings.spacing.max_angle_deg).ceil())
             .max(1.0) as usize;
         for k in 1..pieces {
             let f = k as f64 / pieces as f64;
@@ -603,8 +611,10 @@ mod tests {
     #[test]
     fn densify_respects_distance_and_angle() {
         let settings = CurveScanSettings {
-            max_distance: 1.0,
-            max_angle_deg: 10.0,
+            spacing: ScanSpacing {
+                max_distance: 1.0,
+                max_angle_deg: 10.0,
+            },
             ..CurveScanSettings::default()
         };
         let open = densify(&[nominal(0.0, 0.0), nominal(3.0, 0.0)], false, &settings);
