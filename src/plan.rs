@@ -200,7 +200,7 @@ impl Plan {
             direction: point(start + heading * HEADING_POINT_MM),
             // As densely round the master's nose as the inspections' curve scans (its nominal's tip is fitted to
             // the points there, and the chord's nominal with it), and its rolls round sharp edges in the steps of
-            // the scan's `max_angle_deg` or finer (the taught rolls are thinned again, see `reference`).
+            // the scan's `max_angle_deg` or finer (the taught rolls are thinned again for the nominals, see `rolls`).
             spacing: InPlaneSpacing::Spacing {
                 max_distance: self.part.scan.step_mm,
                 max_angle: self.part.scan.finest_angle_deg().to_radians(),
