@@ -389,14 +389,14 @@ mod tests {
         assert_eq!(campaign.farther, 0, "{campaign:?}");
     }
 
-    /// The campaign: `cargo test --release --lib blade_stack_campaign -- --ignored --nocapture`. A foot
-    /// the certificate could not prove may be a local one; a proved foot may not.
+    /// The campaign: `cargo test --release --lib blade_stack_campaign -- --ignored --nocapture`. No foot
+    /// may lie farther than the reference; those the certificate could not prove are counted and printed.
     #[test]
     #[ignore = "100 000 points: minutes in a release build"]
     fn blade_stack_campaign() {
         let campaign = check_against_the_sampled_surface(100_000, 7);
         println!("{campaign:?}");
-        assert_eq!(campaign.proved_farther, 0, "{campaign:?}");
+        assert_eq!(campaign.farther, 0, "{campaign:?}");
     }
 
     /// Points where the stack's distance before its certificate took a local foot (found by this check over
@@ -408,6 +408,14 @@ mod tests {
         [471.429911, -35.242767, -11.787687],
         [399.706357, 73.600185, 33.324518],
         [101.970601, 77.573251, 48.731551],
+    ];
+
+    /// Points the campaign (seed 7) left unproved before the boxes left over when the budget runs out started
+    /// Newton, and before a small box that Newton did not settle was split on: the first lies near a centre of
+    /// curvature and took a local foot 76 um too far; the second's foot, on the profile at x = 400 mm, was right.
+    const ONCE_UNPROVED: [[f64; 3]; 2] = [
+        [101.59425401821211, 76.80037560486106, 48.3262859350777],
+        [400.616201542648, 61.143388003646606, 24.492713775724987],
     ];
 
     /// What a check found: feet farther than the reference (by more than 1e-6 mm), how many of them proved, and
@@ -479,6 +487,16 @@ mod tests {
             campaign.points += 1;
             campaign.inside += usize::from(foot.distance < -1.0);
             campaign.unproved += usize::from(!proved);
+            if !proved {
+                println!(
+                    "at [{}, {}, {}]: {} mm, unproved ({:+e} mm from the reference)",
+                    p.x,
+                    p.y,
+                    p.z,
+                    foot.distance,
+                    foot.distance.abs() - reference
+                );
+            }
             if beyond > 1e-6 {
                 println!(
                     "at {p}: {} mm, {beyond} mm beyond the reference (proved: {proved})",
@@ -490,8 +508,8 @@ mod tests {
             }
             true
         };
-        for p in ONCE_LOCAL {
-            assert!(check(Vector3::from(p)), "{p:?} lies within 5 mm");
+        for p in ONCE_LOCAL.iter().chain(&ONCE_UNPROVED) {
+            assert!(check(Vector3::from(*p)), "{p:?} lies within 5 mm");
         }
         let bounds = stack.bounds(&domains).scaled(0.6);
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
