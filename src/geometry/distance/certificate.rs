@@ -214,7 +214,8 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
     /// along the curve's normal. A zero c + u on the slab's
     /// side (side * u_x >= 0) then has |p - c - u|^2 - d^2 = |u|^2 + 2 lambda F(c) + lambda u'H u - 2 mu u_x: where
     /// mu points out of the slab the last term only helps, and the rest is the proof of an ordinary foot with
-    /// |lambda| |grad F| in place of the distance.
+    /// |lambda| |grad F| in place of the distance; where that alone fails, the last term pays for the bending
+    /// along x (`Local::proves_beside_crease`).
     pub(crate) fn crease_ball(
         &self,
         p: &SVector<f64, N>,
@@ -247,6 +248,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
                 && (r_plane - in_plane * lambda).norm() + (side * mu).max(0.0)
                     <= TOLERANCE_MM / 8.0,
             side: if lambda < 0.0 { -1.0 } else { 1.0 },
+            outward: (-side * mu).max(0.0),
         };
         let taylor = self.f.taylor(c)?;
         let reach = 2.0 * d;
@@ -315,8 +317,9 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
                 if let Some(other) = lagrange_newton(self.f, p, &centre)
                     .filter(|other| self.slab.is_none_or(|slab| slab.holds(other.point[0])))
                 {
+                    // Nearer by less than the tolerance is the foot itself, found again with its rounding.
                     let other_d = other.distance.abs();
-                    if other_d < d {
+                    if other_d < d - TOLERANCE_MM {
                         return Verdict::Nearer(other);
                     }
                     let known = balls
@@ -489,6 +492,8 @@ struct Local<const N: usize> {
     admissible: bool,
     /// +1 where p lies along the gradient from the foot (outside), -1 inside.
     side: f64,
+    /// At a crease: how far p - c leans out of the slab along x (mu's outward part, mm; 0 for an ordinary foot).
+    outward: f64,
 }
 
 impl<const N: usize> Local<N> {
@@ -512,6 +517,7 @@ impl<const N: usize> Local<N> {
             off_zero_set,
             admissible: off_zero_set <= TOLERANCE_MM / 8.0 && off_normal <= TOLERANCE_MM / 8.0,
             side: if offset.dot(&normal) < 0.0 { -1.0 } else { 1.0 },
+            outward: 0.0,
         }
     }
 
@@ -552,9 +558,64 @@ impl<const N: usize> Local<N> {
         };
         let towards_p = -(along - 2.0 * lean * cross - lean * lean * normal - e);
         // A margin for the rounding of the expansion and of these sums.
-        self.lever * towards_p <= self.gradient_norm * (1.0 - 1e-9)
+        self.lever * towards_p <= self.gradient_norm * (1.0 - ROUNDING_MARGIN)
+            || self.proves_beside_crease(bound, extent)
+    }
+
+    /// The same beside a crease (a surface's, N = 3), for zeros on the slab's side only, where the bending
+    /// towards p along x is paid for by how far p leans out of the slab. With t1 the crease's tangent (normal to
+    /// n and to x), t2 the tangent plane's direction nearest to x (its x-part sigma = |n x e_x|), u = a t1 + b t2
+    /// + v n and mu' the outward lean: the ordinary proof's terms give |p - x|^2 - d^2 >= c0 |u|^2 + L q(a, b)
+    /// + 2 mu' |u_x| less the tolerance's share, with L = lever / G and q the tangential Hessian (towards p);
+    /// on the slab's side |u_x| >= sigma |b| - |n_x| |v| and |v| <= |F| / G + (|H| + e) |u|^2 / 2G. What is left,
+    /// A a^2 + 2 B a b + C b^2 + 2 mu' sigma |b| (A = c0 + L q11, B = L q12, C = c0 + L q22), is at least
+    /// -K b^2 + 2 mu' sigma |b| with K = B^2 / A - C once A > 0, which holds for |b| <= |u| <= extent when
+    /// K extent <= 2 mu' sigma: a crease seen from well out of the slab clears a ball its bending alone could not.
+    fn proves_beside_crease(&self, bound: &HessianBound<N>, extent: f64) -> bool {
+        let n = &self.normal;
+        if N != 3 || self.outward <= 0.0 {
+            return false;
+        }
+        let mut t1 = SVector::<f64, N>::zeros();
+        t1[1] = -n[2];
+        t1[2] = n[1];
+        let sigma = t1.norm();
+        if sigma <= 1e-12 {
+            return false;
+        }
+        t1 /= sigma;
+        let mut t2 = -n * n[0];
+        t2[0] += 1.0;
+        t2 /= sigma;
+        let h = bound.hessian * self.side;
+        let e = bound.variation;
+        let g = self.gradient_norm;
+        let spread = (h.norm() + e) / (2.0 * g);
+        // The lean's constant part, 2 mu' |n_x| |F| / G, is the tolerance's to absorb.
+        if 2.0 * self.outward * n[0].abs() * self.off_zero_set > self.d * TOLERANCE_MM / 8.0 {
+            return false;
+        }
+        let lean = (self.off_zero_set / TOLERANCE_MM + spread * extent).min(1.0);
+        let hn = h * n;
+        let cross = (t1.dot(&hn).powi(2) + t2.dot(&hn).powi(2)).sqrt();
+        let normal = n.dot(&hn).abs();
+        let l = self.lever / g;
+        let c0 = 1.0
+            - l * (2.0 * lean * cross + lean * lean * normal + e)
+            - 2.0 * self.outward * n[0].abs() * spread;
+        let a = c0 + l * t1.dot(&(h * t1));
+        let b = l * t1.dot(&(h * t2));
+        let c = c0 + l * t2.dot(&(h * t2));
+        if c0 <= ROUNDING_MARGIN || a <= ROUNDING_MARGIN {
+            return false;
+        }
+        let k = b * b / a - c;
+        k <= 0.0 || k * extent <= 2.0 * self.outward * sigma * (1.0 - ROUNDING_MARGIN)
     }
 }
+
+/// The proofs' relative margin for the rounding of the expansion and of their sums.
+const ROUNDING_MARGIN: f64 = 1e-9;
 
 /// An orthonormal basis of the tangent space at a normal `n` (N - 1 vectors), by Gram-Schmidt on the axes least
 /// aligned with it.
@@ -711,6 +772,36 @@ mod tests {
             frame: Frame::identity(),
             poly: Poly::new(1, vec![0.0, 0.0, 1.0, 0.0]),
         }
+    }
+
+    #[test]
+    fn a_crease_seen_from_out_of_its_slab_clears_a_ball_its_bending_towards_p_alone_could_not() {
+        // The parabolic sheet y = x^2 (F = y - x^2), cut at x = 0, seen from p = (-1/2, 1, 0): the crease is the
+        // z axis and its nearest point the origin, d^2 = 5/4. Along x the sheet bends towards p with curvature 2,
+        // twice what a lever of 1 allows, so the ordinary proof fails at every radius. On the slab's side x >= 0,
+        // |p - x|^2 - d^2 = x - x^2 + x^4 >= 0 up to x = 1: p's lean out of the slab (mu' = 1/2) clears a ball of
+        // radius 1 there. On the side x <= 0 the same sheet comes nearer (x - x^2 + x^4 < 0), and no ball is
+        // cleared.
+        let mut poly = Poly::<3>::zero(2);
+        let y = poly.basis().index_of(&[0, 1, 0]).unwrap();
+        let xx = poly.basis().index_of(&[2, 0, 0]).unwrap();
+        poly.coeffs_mut()[y] = 1.0;
+        poly.coeffs_mut()[xx] = -1.0;
+        let model = IpModel {
+            frame: Frame::identity(),
+            poly,
+        };
+        let p = nalgebra::Vector3::new(-0.5, 1.0, 0.0);
+        let c = nalgebra::Vector3::zeros();
+        let d = 1.25f64.sqrt();
+        let within = Certifier::within(&model, Slab { lo: 0.0, hi: 10.0 });
+        let (_, radius) = within.crease_ball(&p, &c, d, 1.0).unwrap();
+        assert!(radius >= d / 2.0 && radius <= 1.0, "{radius}");
+        let beyond = Certifier::within(&model, Slab { lo: -10.0, hi: 0.0 });
+        assert_eq!(beyond.crease_ball(&p, &c, d, -1.0), None);
+        // The sheet's nearer zeros beyond x = 0: x = -0.3 is 0.0519 nearer in d^2.
+        let nearer = nalgebra::Vector3::new(-0.3, 0.09, 0.0);
+        assert!((p - nearer).norm() < d - 0.02);
     }
 
     #[test]
