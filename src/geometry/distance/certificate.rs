@@ -564,13 +564,14 @@ impl<const N: usize> Local<N> {
 
     /// The same beside a crease (a surface's, N = 3), for zeros on the slab's side only, where the bending
     /// towards p along x is paid for by how far p leans out of the slab. With t1 the crease's tangent (normal to
-    /// n and to x), t2 the tangent plane's direction nearest to x (its x-part sigma = |n x e_x|), u = a t1 + b t2
-    /// + v n and mu' the outward lean: the ordinary proof's terms give |p - x|^2 - d^2 >= c0 |u|^2 + L q(a, b)
-    /// + 2 mu' |u_x| less the tolerance's share, with L = lever / G and q the tangential Hessian (towards p);
-    /// on the slab's side |u_x| >= sigma |b| - |n_x| |v| and |v| <= |F| / G + (|H| + e) |u|^2 / 2G. What is left,
-    /// A a^2 + 2 B a b + C b^2 + 2 mu' sigma |b| (A = c0 + L q11, B = L q12, C = c0 + L q22), is at least
-    /// -K b^2 + 2 mu' sigma |b| with K = B^2 / A - C once A > 0, which holds for |b| <= |u| <= extent when
-    /// K extent <= 2 mu' sigma: a crease seen from well out of the slab clears a ball its bending alone could not.
+    /// n and to x), t2 the tangent plane's direction nearest to x (its x-part sigma = |n x e_x|), u = a t1 +
+    /// b t2 + v n and mu' the outward lean, the ordinary proof's terms give |p - x|^2 - d^2 >= c0 |u|^2 +
+    /// L q(a, b) + 2 mu' |u_x|, less the tolerance's share, with L = lever / G and q the tangential Hessian
+    /// (towards p). On the slab's side |u_x| >= sigma |b| - |n_x| |v|, and |v| <= |F| / G + (|H| + e) |u|^2 / 2G.
+    /// What is left, A a^2 + 2 B a b + C b^2 + 2 mu' sigma |b| with A = c0 + L q11, B = L q12 and C = c0 +
+    /// L q22, is at least 2 mu' sigma |b| - K b^2 with K = B^2 / A - C once A > 0. That holds for |b| <= |u| <=
+    /// extent when K extent <= 2 mu' sigma: a crease seen from well out of the slab clears a ball its bending
+    /// alone could not.
     fn proves_beside_crease(&self, bound: &HessianBound<N>, extent: f64) -> bool {
         let n = &self.normal;
         if N != 3 || self.outward <= 0.0 {
