@@ -10,7 +10,8 @@ use nalgebra::{SVector, Vector2, Vector3};
 use super::{all_rows, MethodArg};
 use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
-use crate::geometry::fit3l::{fit_ip, FitOptions, Fitted};
+use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
+use crate::geometry::held_out::{choose_degree, profile_scores};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
 use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
@@ -22,7 +23,8 @@ pub struct FitIpArgs {
     #[arg(long)]
     points: PathBuf,
     /// Degree of the polynomial (of each profile, for a stack; of each face, for a profile with sharp edges), 1 to
-    /// 16. By default 4; a face's is chosen from 4, 6 and 8 by the points held out of its fit.
+    /// 16. By default a profile's (or each face's) is chosen from 4, 6 and 8 by the points held out of its fit; a
+    /// stack's profiles and a surface are fitted at 4.
     #[arg(long, value_parser = degree)]
     degree: Option<usize>,
     /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
@@ -102,24 +104,10 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
             match fit_faces_of(args, &points)? {
                 Some(faced) => (ReferenceModel::Faces(faced), options.method),
-                None => {
-                    let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
-                    print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
-                    (
-                        ReferenceModel::Profile(FittedIp::from(fitted.clone())),
-                        fitted.method,
-                    )
-                }
+                None => one_polynomial(args, &points)?,
             }
         }
-        (PointSet::Profile(points), false) => {
-            let fitted = fit_profile(&args.points, &points, &options, args.normals)?;
-            print_fit(&args.points, "profile", &fitted, &points, args.tolerance);
-            (
-                ReferenceModel::Profile(FittedIp::from(fitted.clone())),
-                fitted.method,
-            )
-        }
+        (PointSet::Profile(points), false) => one_polynomial(args, &points)?,
         (PointSet::Spatial(points), false) => {
             if args.normals == NormalsArg::Ordered {
                 bail!(
@@ -255,30 +243,62 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
     Ok(Some(faced))
 }
 
-fn fit_profile(
-    path: &Path,
+/// A profile fitted as one polynomial, printed. Its degree is `--degree`'s, or else the one of 4, 6 and 8 that the points held out of its fit choose; where that degree's fit has a defect the
+/// statistics show (a spurious branch or sliver beside the data, points with no foot), the next best by held-out
+/// RMS whose fit has none.
+fn one_polynomial(
+    args: &FitIpArgs,
     points: &[Vector2<f64>],
-    options: &FitOptions,
-    normals: NormalsArg,
-) -> anyhow::Result<Fitted<2>> {
-    if points.len() < 3 {
-        bail!(
-            "{}: {} points are too few for a profile",
-            all_rows(path, points.len()),
-            points.len()
+) -> anyhow::Result<(ReferenceModel, FitMethod)> {
+    let path = &args.points;
+    let normals = profile_normals(path, points, args.normals)?;
+    let method: FitMethod = args.method.into();
+    let fit = |degree: usize| {
+        fit_ip(points, &normals, &FitOptions::new(degree, method))
+            .map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
+    };
+    let (fitted, scores) = match args.degree {
+        Some(degree) => (fit(degree)?, Vec::new()),
+        None => {
+            let scores = profile_scores(points, &normals, method);
+            let chosen = choose_degree(&scores);
+            let mut others = scores.clone();
+            others.sort_by(|a, b| a.1.total_cmp(&b.1));
+            let mut fallbacks = others.iter().map(|(d, _)| *d).filter(|d| *d != chosen);
+            let first = fit(chosen)?;
+            let clean = |f: &Fitted<2>| {
+                let s = &f.stats;
+                s.branches_beside_data == 0
+                    && s.side_segments_crossed_again == 0
+                    && s.points_without_foot == 0
+            };
+            let fitted = if clean(&first) {
+                first
+            } else {
+                fallbacks
+                    .find_map(|degree| fit(degree).ok().filter(clean))
+                    .unwrap_or(first)
+            };
+            (fitted, scores)
+        }
+    };
+    print_fit(path, "profile", &fitted, points, args.tolerance);
+    if !scores.is_empty() {
+        let scores: Vec<String> = scores
+            .iter()
+            .map(|(d, rms)| format!("{d}: {:.2} um", rms * 1000.0))
+            .collect();
+        println!(
+            "  degree {} chosen by the RMS distance of the points held out of the fit ({}); --degree gives \
+             one",
+            fitted.model.degree(),
+            scores.join(", ")
         );
     }
-    let ordered = match normals {
-        NormalsArg::Ordered => true,
-        NormalsArg::Pca => false,
-        NormalsArg::Auto => runs_along_the_profile(points),
-    };
-    let normals = if ordered {
-        ordered_profile_normals(points)
-    } else {
-        pca_normals(points)
-    };
-    fit_ip(points, &normals, options).map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
+    Ok((
+        ReferenceModel::Profile(FittedIp::from(fitted.clone())),
+        fitted.method,
+    ))
 }
 
 /// Whether the points are in scan order: nearly every step to the next point is about as short as the step to
@@ -297,6 +317,42 @@ fn runs_along_the_profile<const N: usize>(points: &[SVector<f64, N>]) -> bool {
         })
         .count();
     in_order as f64 >= 0.95 * n as f64
+}
+
+/// The outward normals of a profile's points, for its 3L offsets.
+fn profile_normals(
+    path: &Path,
+    points: &[Vector2<f64>],
+    normals: NormalsArg,
+) -> anyhow::Result<Vec<Vector2<f64>>> {
+    if points.len() < 3 {
+        bail!(
+            "{}: {} points are too few for a profile",
+            all_rows(path, points.len()),
+            points.len()
+        );
+    }
+    let ordered = match normals {
+        NormalsArg::Ordered => true,
+        NormalsArg::Pca => false,
+        NormalsArg::Auto => runs_along_the_profile(points),
+    };
+    Ok(if ordered {
+        ordered_profile_normals(points)
+    } else {
+        pca_normals(points)
+    })
+}
+
+/// A stack's profile at one x, fitted at the stack's degree.
+fn fit_profile(
+    path: &Path,
+    points: &[Vector2<f64>],
+    options: &FitOptions,
+    normals: NormalsArg,
+) -> anyhow::Result<Fitted<2>> {
+    let normals = profile_normals(path, points, normals)?;
+    fit_ip(points, &normals, options).map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
 }
 
 fn fit_stack(

@@ -5,6 +5,7 @@ pub(crate) mod circle;
 pub mod distance;
 pub mod faces;
 pub mod fit3l;
+pub(crate) mod held_out;
 pub mod implicit;
 pub mod interp;
 pub mod nearest;

@@ -5,7 +5,8 @@ use nalgebra::Vector2;
 use super::split::{face_normals, find_corners, orientation, perimeter, split_at_corners};
 use super::{meeting_point, trace_face, FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::implicit::{Implicit, IpModel};
+use crate::geometry::held_out::{choose_degree, rms_distance, CANDIDATE_DEGREES};
+use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{project_to_zero_set, Aabb};
 
 /// How many times a sharp edge's own point counts in the fits of the faces that meet there. The edge is where
@@ -13,11 +14,6 @@ use crate::geometry::sampling::{project_to_zero_set, Aabb};
 /// across their length moves it along the edge's bisector 14 times as far; held to the measured edge, both faces
 /// cross within the probe's noise of it. (Measured on NACA 0006 sections: see BENCHMARKS.md.)
 const EDGE_WEIGHT: usize = 20;
-/// The degrees a face's fit chooses from when none is given.
-const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
-/// A higher degree replaces the one chosen so far only when its held-out RMS is below this fraction of that one's:
-/// noise alone moves a held-out RMS by a few percent.
-const HIGHER_DEGREE_GAIN: f64 = 0.9;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FacesFitOptions {
@@ -197,32 +193,4 @@ fn runs_along(model: &IpModel<2>, face_points: &[Vector2<f64>]) -> bool {
         &limits,
     )
     .is_ok()
-}
-
-/// The degree by held-out RMS: from the lowest up, each higher degree replaces the one chosen so far only if it
-/// beats it by more than noise does ([`HIGHER_DEGREE_GAIN`]).
-fn choose_degree(scores: &[(usize, f64)]) -> usize {
-    let mut chosen = scores
-        .first()
-        .copied()
-        .unwrap_or((CANDIDATE_DEGREES[0], 0.0));
-    for &(degree, rms) in &scores[1.min(scores.len())..] {
-        if rms < HIGHER_DEGREE_GAIN * chosen.1 {
-            chosen = (degree, rms);
-        }
-    }
-    chosen.0
-}
-
-/// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
-/// the model, where the first-order distance is exact to second order.
-fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
-    let sum: f64 = points
-        .iter()
-        .map(|p| {
-            let (v, g) = model.value_gradient(p);
-            (v / g.norm()).powi(2)
-        })
-        .sum();
-    (sum / points.len() as f64).sqrt()
 }

@@ -1,0 +1,134 @@
+//! A polynomial's degree chosen by points held out of its fit. A fit's own residual always falls as the degree
+//! rises (a higher degree also follows the noise); the distance of points it was not fitted to stops falling once
+//! the shape is followed, and that is the degree the data supports.
+
+use nalgebra::Vector2;
+
+use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions};
+use crate::geometry::implicit::Implicit;
+
+/// The degrees chosen from when none is given.
+pub(crate) const CANDIDATE_DEGREES: [usize; 3] = [4, 6, 8];
+/// A higher degree replaces the one chosen so far only when its held-out RMS is below this fraction of that one's:
+/// noise alone moves a held-out RMS by a few percent.
+const HIGHER_DEGREE_GAIN: f64 = 0.9;
+
+/// The degree by held-out RMS (`scores`: each degree tried with its held-out RMS, lowest degree first): from the
+/// lowest up, each higher degree replaces the one chosen so far only if it beats it by more than noise does
+/// ([`HIGHER_DEGREE_GAIN`]).
+pub(crate) fn choose_degree(scores: &[(usize, f64)]) -> usize {
+    let mut chosen = scores
+        .first()
+        .copied()
+        .unwrap_or((CANDIDATE_DEGREES[0], 0.0));
+    for &(degree, rms) in &scores[1.min(scores.len())..] {
+        if rms < HIGHER_DEGREE_GAIN * chosen.1 {
+            chosen = (degree, rms);
+        }
+    }
+    chosen.0
+}
+
+/// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
+/// the model, where the first-order distance is exact to second order.
+pub(crate) fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
+    let sum: f64 = points
+        .iter()
+        .map(|p| {
+            let (v, g) = model.value_gradient(p);
+            (v / g.norm()).powi(2)
+        })
+        .sum();
+    (sum / points.len() as f64).sqrt()
+}
+
+/// The held-out RMS (mm) of each of [`CANDIDATE_DEGREES`] for one polynomial round a profile whose points run
+/// along it: each degree fitted to every other point (with its normal), judged by the points between. A degree
+/// whose fit fails is left out.
+pub(crate) fn profile_scores(
+    points: &[Vector2<f64>],
+    normals: &[Vector2<f64>],
+    method: FitMethod,
+) -> Vec<(usize, f64)> {
+    let (trained, trained_normals): (Vec<_>, Vec<_>) =
+        points.iter().zip(normals).step_by(2).unzip();
+    let judged: Vec<Vector2<f64>> = points.iter().skip(1).step_by(2).copied().collect();
+    CANDIDATE_DEGREES
+        .into_iter()
+        .filter_map(|degree| {
+            let fitted =
+                fit_ip(&trained, &trained_normals, &FitOptions::new(degree, method)).ok()?;
+            Some((degree, rms_distance(&fitted.model, &judged)))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::normals::ordered_profile_normals;
+    use crate::geometry::trace::{resample_closed, trace_closed_curve};
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    /// `count` points along a closed curve, each moved along its normal by seeded Gaussian noise of 2 um.
+    fn noisy(curve: &[Vector2<f64>], count: usize, seed: u64) -> Vec<Vector2<f64>> {
+        let clean = resample_closed(curve, count);
+        let normals = ordered_profile_normals(&clean);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let noise = Normal::new(0.0, 0.002).unwrap();
+        clean
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| p + n * noise.sample(&mut rng))
+            .collect()
+    }
+
+    #[test]
+    fn a_quartic_profile_keeps_degree_4_and_a_shape_a_quartic_cannot_follow_takes_a_higher_one() {
+        // Seed 003's profile 3 is a quartic: higher degrees only follow the noise, and do not beat it by 10% on
+        // the points held out. A stadium (a 40 by 10 mm slot: straight sides between half circles) bends at its
+        // tangent points in a way no quartic follows: its held-out RMS at degree 4 is many times the noise.
+        let quartic = crate::geometry::published::seed_003_profile(3).unwrap();
+        let start = crate::geometry::sampling::project_to_zero_set(
+            &quartic,
+            &Vector2::new(100.0, 320.0),
+            50.0,
+        )
+        .unwrap();
+        let curve = trace_closed_curve(&quartic, &start, 0.05, 1_000_000).unwrap();
+        for seed in [1, 2, 3] {
+            let points = noisy(&curve, 400, seed);
+            let normals = ordered_profile_normals(&points);
+            let scores = profile_scores(&points, &normals, FitMethod::default());
+            assert_eq!(choose_degree(&scores), 4, "seed {seed}: {scores:?}");
+            assert!(scores[0].1 < 0.003, "seed {seed}: {scores:?}");
+        }
+        let stadium: Vec<Vector2<f64>> = (0..4_000)
+            .map(|k| {
+                let s = k as f64 / 4_000.0 * (2.0 * 30.0 + 2.0 * std::f64::consts::PI * 5.0);
+                let half_circle = std::f64::consts::PI * 5.0;
+                let (x, y) = if s < 30.0 {
+                    (-15.0 + s, -5.0)
+                } else if s < 30.0 + half_circle {
+                    let a = (s - 30.0) / 5.0 - std::f64::consts::FRAC_PI_2;
+                    (15.0 + 5.0 * a.cos(), 5.0 * a.sin())
+                } else if s < 60.0 + half_circle {
+                    (15.0 - (s - 30.0 - half_circle), 5.0)
+                } else {
+                    let a = (s - 60.0 - half_circle) / 5.0 + std::f64::consts::FRAC_PI_2;
+                    (-15.0 + 5.0 * a.cos(), 5.0 * a.sin())
+                };
+                Vector2::new(x, y)
+            })
+            .collect();
+        let points = noisy(&stadium, 400, 7);
+        let normals = ordered_profile_normals(&points);
+        let scores = profile_scores(&points, &normals, FitMethod::default());
+        let chosen = choose_degree(&scores);
+        let rms_of = |degree: usize| scores.iter().find(|s| s.0 == degree).unwrap().1;
+        assert!(chosen > 4, "{scores:?}");
+        assert!(rms_of(4) > 5.0 * 0.002, "{scores:?}");
+        assert!(rms_of(chosen) < 0.8 * rms_of(4), "{scores:?}");
+    }
+}
