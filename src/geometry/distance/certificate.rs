@@ -363,9 +363,7 @@ impl<'a, F: Implicit<N>, const N: usize> Certifier<'a, F, N> {
         }
         Verdict::Certified
     }
-}
 
-impl<F: Implicit<N>, const N: usize> Certifier<'_, F, N> {
     /// The verdict when the boxes ran out before the disk was covered: Newton from the centres of the nearest
     /// boxes left ([`NEWTON_FROM_LEFT_BOXES`]), where a nearer zero would be if there is one. Where p lies near a
     /// centre of curvature the zero set runs at about the foot's distance over a wide cap, and the boxes that
