@@ -243,9 +243,9 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
     Ok(Some(faced))
 }
 
-/// A profile fitted as one polynomial, printed. Its degree is `--degree`'s, or else the one of 4, 6 and 8 that the points held out of its fit choose; where that degree's fit has a defect the
-/// statistics show (a spurious branch or sliver beside the data, points with no foot), the next best by held-out
-/// RMS whose fit has none.
+/// A profile fitted as one polynomial, printed. Its degree is `--degree`'s, or else the one of 4, 6 and 8 that the
+/// points held out of its fit choose; where that degree's fit has a defect the statistics show (a spurious branch
+/// or sliver beside the data, points with no foot), the next best by held-out RMS whose fit has none.
 fn one_polynomial(
     args: &FitIpArgs,
     points: &[Vector2<f64>],
@@ -257,8 +257,8 @@ fn one_polynomial(
         fit_ip(points, &normals, &FitOptions::new(degree, method))
             .map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
     };
-    let (fitted, scores) = match args.degree {
-        Some(degree) => (fit(degree)?, Vec::new()),
+    let (fitted, scores, chosen) = match args.degree {
+        Some(degree) => (fit(degree)?, Vec::new(), degree),
         None => {
             let scores = profile_scores(points, &normals, method);
             let chosen = choose_degree(&scores);
@@ -279,7 +279,7 @@ fn one_polynomial(
                     .find_map(|degree| fit(degree).ok().filter(clean))
                     .unwrap_or(first)
             };
-            (fitted, scores)
+            (fitted, scores, chosen)
         }
     };
     print_fit(path, "profile", &fitted, points, args.tolerance);
@@ -288,10 +288,17 @@ fn one_polynomial(
             .iter()
             .map(|(d, rms)| format!("{d}: {:.2} um", rms * 1000.0))
             .collect();
+        let degree = fitted.model.degree();
+        let why = if degree == chosen {
+            "chosen by".to_string()
+        } else {
+            format!(
+                "taken because degree {chosen}, chosen by the points held out, fits with a spurious branch, sliver \
+                 or footless point; see"
+            )
+        };
         println!(
-            "  degree {} chosen by the RMS distance of the points held out of the fit ({}); --degree gives \
-             one",
-            fitted.model.degree(),
+            "  degree {degree} {why} the RMS distance of the points held out of the fit ({}); --degree gives one",
             scores.join(", ")
         );
     }
