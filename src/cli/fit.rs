@@ -11,7 +11,7 @@ use super::{all_rows, MethodArg};
 use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::held_out::{choose_degree, profile_scores};
+use crate::geometry::held_out::{choose_degree, degrees_to_try, profile_scores};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
 use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
@@ -262,9 +262,6 @@ fn one_polynomial(
         None => {
             let scores = profile_scores(points, &normals, method);
             let chosen = choose_degree(&scores);
-            let mut others = scores.clone();
-            others.sort_by(|a, b| a.1.total_cmp(&b.1));
-            let mut fallbacks = others.iter().map(|(d, _)| *d).filter(|d| *d != chosen);
             let first = fit(chosen)?;
             let clean = |f: &Fitted<2>| {
                 let s = &f.stats;
@@ -275,8 +272,9 @@ fn one_polynomial(
             let fitted = if clean(&first) {
                 first
             } else {
-                fallbacks
-                    .find_map(|degree| fit(degree).ok().filter(clean))
+                degrees_to_try(chosen, &scores)[1..]
+                    .iter()
+                    .find_map(|&degree| fit(degree).ok().filter(clean))
                     .unwrap_or(first)
             };
             (fitted, scores, chosen)

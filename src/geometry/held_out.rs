@@ -29,6 +29,16 @@ pub(crate) fn choose_degree(scores: &[(usize, f64)]) -> usize {
     chosen.0
 }
 
+/// The degrees to try in turn: `chosen` first, then the others of `scores` by their held-out RMS, best first (a
+/// fit of the chosen degree can still fail a check the held-out RMS does not make).
+pub(crate) fn degrees_to_try(chosen: usize, scores: &[(usize, f64)]) -> Vec<usize> {
+    let mut others = scores.to_vec();
+    others.sort_by(|a, b| a.1.total_cmp(&b.1));
+    std::iter::once(chosen)
+        .chain(others.into_iter().map(|(d, _)| d).filter(|d| *d != chosen))
+        .collect()
+}
+
 /// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
 /// the model, where the first-order distance is exact to second order.
 pub(crate) fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
@@ -82,6 +92,14 @@ mod tests {
             .zip(&normals)
             .map(|(p, n)| p + n * noise.sample(&mut rng))
             .collect()
+    }
+
+    #[test]
+    fn the_chosen_degree_is_tried_first_and_then_the_others_best_held_out_first() {
+        let scores = [(4, 0.005), (6, 0.0021), (8, 0.0020)];
+        assert_eq!(choose_degree(&scores), 6);
+        assert_eq!(degrees_to_try(6, &scores), vec![6, 8, 4]);
+        assert_eq!(degrees_to_try(4, &[]), vec![4]);
     }
 
     #[test]

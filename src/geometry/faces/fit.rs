@@ -5,7 +5,7 @@ use nalgebra::Vector2;
 use super::split::{face_normals, find_corners, orientation, perimeter, split_at_corners};
 use super::{meeting_point, trace_face, FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::held_out::{choose_degree, rms_distance, CANDIDATE_DEGREES};
+use crate::geometry::held_out::{choose_degree, degrees_to_try, rms_distance, CANDIDATE_DEGREES};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{project_to_zero_set, Aabb};
 
@@ -103,10 +103,7 @@ pub fn fit_faces(
         };
         // The chosen degree first, then the others by their held-out RMS: the first whose curve runs along the
         // face's points from end to end (a short, nearly straight face can leave a degree's curve crossing itself).
-        let mut order: Vec<usize> = vec![degree];
-        let mut others = scores.clone();
-        others.sort_by(|a, b| a.1.total_cmp(&b.1));
-        order.extend(others.iter().map(|(d, _)| *d).filter(|d| *d != degree));
+        let order = degrees_to_try(degree, &scores);
         let mut face_fit = Err(FacesError::Untraceable {
             face: j,
             from: face_points[0].into(),
