@@ -56,10 +56,10 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let root =
         std::env::temp_dir().join(format!("zeroset-demo-{}", crate::station::clock::unix_ms()));
     std::fs::create_dir_all(&root).with_context(|| format!("cannot create {}", root.display()))?;
-    println!(
+    reportln!(
         "zeroset demo: simulator and daemon in {} (all lengths in mm)",
         root.display()
-    );
+    )?;
     let exe = std::env::current_exe().context("locating the zeroset binary")?;
 
     let ports = root.join("ports");
@@ -98,17 +98,17 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         },
         detach: false,
     };
-    println!("\n== teach: scanning the master blade A and fitting its reference ==");
+    reportln!("\n== teach: scanning the master blade A and fitting its reference ==")?;
     run_job(
         &job,
         Request::Teach {
             part: args.part.clone(),
         },
     )?;
-    println!(
+    reportln!(
         "\n== inspect {}: blades A, B and C, deviations live ==",
         args.serial
-    );
+    )?;
     run_job(
         &job,
         Request::Inspect {
@@ -118,11 +118,11 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     )?;
     drop(daemon);
     drop(sim);
-    println!(
+    reportln!(
         "\ndemo done in {:.1} s; daemon log in {}",
         started.elapsed().as_secs_f64(),
         root.join("logs").display()
-    );
+    )?;
     Ok(())
 }
 

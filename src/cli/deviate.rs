@@ -159,11 +159,11 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
         &["x", "y", "z"]
     };
     write_csv(&args.out, header, &rows, &distances)?;
-    print_summary(&args.points, &file, method, &distances);
+    print_summary(&args.points, &file, method, &distances)?;
     if let Some(unproved) = unproved {
-        print_certificates(&distances, unproved);
+        print_certificates(&distances, unproved)?;
     }
-    name_points_out_of_range(&point_file.lines, &distances);
+    name_points_out_of_range(&point_file.lines, &distances)?;
     if distances.iter().all(Result::is_err) {
         anyhow::bail!(
             "{}: no point has a deviation from {} (see the status column of {})",
@@ -172,11 +172,11 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
             args.out.display()
         );
     }
-    println!(
+    reportln!(
         "wrote {} ({:.2} s)",
         args.out.display(),
         started.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }
 
@@ -207,7 +207,10 @@ fn within<const N: usize>(
 }
 
 /// The lines of the points left unmeasured for being outside the model's range, so the operator can find them.
-fn name_points_out_of_range(lines: &[u64], distances: &[Result<f64, DistanceError>]) {
+fn name_points_out_of_range(
+    lines: &[u64],
+    distances: &[Result<f64, DistanceError>],
+) -> anyhow::Result<()> {
     let outside: Vec<String> = distances
         .iter()
         .zip(lines)
@@ -215,16 +218,17 @@ fn name_points_out_of_range(lines: &[u64], distances: &[Result<f64, DistanceErro
         .map(|(_, line)| line.to_string())
         .collect();
     if outside.is_empty() {
-        return;
+        return Ok(());
     }
     let shown = outside.len().min(10);
     let more = if outside.len() > shown { ", ..." } else { "" };
-    println!(
+    reportln!(
         "  warning: {} point(s) lie far outside the model's range (its data's box, doubled) and were not measured \
          (line {}{more}): points of another part, or a unit or export error?",
         outside.len(),
         outside[..shown].join(", ")
-    );
+    )?;
+    Ok(())
 }
 
 fn coordinates<const N: usize>(points: &[SVector<f64, N>]) -> Vec<Vec<f64>> {
@@ -255,21 +259,25 @@ fn distances_to<const N: usize>(
 }
 
 /// Says how many exact distances are proved global minima: a Newton foot is only ever a critical point.
-fn print_certificates(distances: &[Result<f64, DistanceError>], unproved: usize) {
+fn print_certificates(
+    distances: &[Result<f64, DistanceError>],
+    unproved: usize,
+) -> anyhow::Result<()> {
     let measured = distances.iter().filter(|d| d.is_ok()).count();
-    println!(
+    reportln!(
         "  certificate: {} of {measured} distances proved the global minimum (no zero of the model nearer, to \
          {:.0e} mm)",
         measured.saturating_sub(unproved),
         CERTIFICATE_TOLERANCE_MM
-    );
+    )?;
     if unproved > 0 {
-        println!(
+        reportln!(
             "  warning: {unproved} distance(s) left unproved: each is the nearest foot the search found, which the \
              certificate could neither prove nor beat within its budget (most often a point on a centre of \
              curvature, where two feet are about equally near)"
-        );
+        )?;
     }
+    Ok(())
 }
 
 fn write_csv(
@@ -300,30 +308,30 @@ fn print_summary(
     file: &ModelFile,
     method: DistanceMethod,
     distances: &[Result<f64, DistanceError>],
-) {
+) -> anyhow::Result<()> {
     let values: Vec<f64> = distances
         .iter()
         .filter_map(|d| d.as_ref().ok().copied())
         .collect();
     let failed = distances.len() - values.len();
-    println!(
+    reportln!(
         "deviations of {} from the model ({}), by the {}:",
         points.display(),
         file.method,
         method.describe()
-    );
+    )?;
     if values.is_empty() {
-        println!("  no point has a deviation");
+        reportln!("  no point has a deviation")?;
     } else {
         let n = values.len() as f64;
         let mean = values.iter().sum::<f64>() / n;
         let rms = (values.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
         let min = values.iter().copied().fold(f64::INFINITY, f64::min);
         let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        println!(
+        reportln!(
             "  n = {}, mean {mean:+.4} mm, RMS {rms:.4} mm, min {min:+.4} mm, max {max:+.4} mm",
             values.len()
-        );
+        )?;
     }
     if failed > 0 {
         let hint = match method {
@@ -332,6 +340,7 @@ fn print_summary(
             }
             _ => "outside the model's range, or where the model has no zero set nearby",
         };
-        println!("  {failed} point(s) without a deviation, see the status column ({hint})");
+        reportln!("  {failed} point(s) without a deviation, see the status column ({hint})")?;
     }
+    Ok(())
 }

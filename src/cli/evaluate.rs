@@ -114,7 +114,7 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         |moved| nominal.measure(moved),
     )
     .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
-    println!(
+    reportln!(
         "section {} ({} points) against {}; best fit: {mode_name} by {method_name}, about the chord's middle \
          ({:.3}, {:.3}) mm",
         args.points.display(),
@@ -122,8 +122,8 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
         args.model.display(),
         pivot.x,
         pivot.y
-    );
-    print_fit(&fitted, &chord, &settings.limits());
+    )?;
+    print_fit(&fitted, &chord, &settings.limits())?;
     let measured = section_parameters(&points, &[], args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     let nominal = nominal
@@ -132,10 +132,10 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
             section_parameters(&outline, &[], args.edge_distance).map_err(|e| e.to_string())
         })
         .map_err(|e| anyhow!("{}: {e}", args.model.display()));
-    print_parameters(&measured, nominal, args.edge_distance);
+    print_parameters(&measured, nominal, args.edge_distance)?;
     if let Some(out) = &args.out {
         write_deviations(out, &points, &fitted)?;
-        println!("wrote {}", out.display());
+        reportln!("wrote {}", out.display())?;
     }
     Ok(())
 }
@@ -212,17 +212,21 @@ impl<'a> Nominal<'a> {
     }
 }
 
-fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>, limits: &BestFitLimits) {
+fn print_fit(
+    fitted: &SectionFit,
+    chord: &Vector2<f64>,
+    limits: &BestFitLimits,
+) -> anyhow::Result<()> {
     let across = Vector2::new(-chord.y, chord.x);
-    println!(
+    reportln!(
         "  chord direction (y, z) ({:.5}, {:.5}); thickness direction, the chord turned +90 deg, ({:.5}, {:.5})",
         chord.x, chord.y, across.x, across.y
-    );
-    println!(
+    )?;
+    reportln!(
         "  the section lies {:+.4} mm along the thickness direction and {:+.4} mm along the chord from the \
          nominal, turned {:+.4} deg (counter-clockwise +)",
         fitted.dn_mm, fitted.dchord_mm, fitted.rotation_deg
-    );
+    )?;
     let held = [
         ("along the chord", limits.dchord_mm, "mm"),
         ("along the thickness", limits.dn_mm, "mm"),
@@ -235,11 +239,12 @@ fn print_fit(fitted: &SectionFit, chord: &Vector2<f64>, limits: &BestFitLimits) 
             } else {
                 "not reached"
             };
-            println!("  limit {what} +-{limit} {unit}: {state}");
+            reportln!("  limit {what} +-{limit} {unit}: {state}")?;
         }
     }
-    print_form("as measured:  ", &fitted.form_before);
-    print_form("after the fit:", &fitted.form);
+    print_form("as measured:  ", &fitted.form_before)?;
+    print_form("after the fit:", &fitted.form)?;
+    Ok(())
 }
 
 /// One of a section's parameters, read from them.
@@ -250,8 +255,8 @@ fn print_parameters(
     measured: &SectionParameters,
     nominal: anyhow::Result<SectionParameters>,
     edge_distance_mm: f64,
-) {
-    println!(
+) -> anyhow::Result<()> {
+    reportln!(
         "  parameters (leading edge the blunter end, at ({:.3}, {:.3}) mm; edge thicknesses {edge_distance_mm} mm \
          in from each edge; camber and chord angle from the mean line, its chord from ({:.3}, {:.3}) to ({:.3}, \
          {:.3}) mm):",
@@ -261,17 +266,20 @@ fn print_parameters(
         measured.mean_line.leading_end.y,
         measured.mean_line.trailing_end.x,
         measured.mean_line.trailing_end.y
-    );
+    )?;
     let nominal = match nominal {
         Ok(nominal) => {
-            println!(
+            reportln!(
                 "    {:<34} {:>12} {:>12} {:>12}",
-                "", "measured", "nominal", "deviation"
-            );
+                "",
+                "measured",
+                "nominal",
+                "deviation"
+            )?;
             Some(nominal)
         }
         Err(error) => {
-            println!("    no nominal parameters: {error:#}");
+            reportln!("    no nominal parameters: {error:#}")?;
             None
         }
     };
@@ -290,21 +298,23 @@ fn print_parameters(
     for (name, value) in rows {
         let m = value(measured);
         match &nominal {
-            Some(n) => println!(
+            Some(n) => reportln!(
                 "    {name:<34} {m:>12.4} {:>12.4} {:>+12.4}",
                 value(n),
                 m - value(n)
             ),
-            None => println!("    {name:<34} {m:>12.4}"),
-        }
+            None => reportln!("    {name:<34} {m:>12.4}"),
+        }?;
     }
+    Ok(())
 }
 
-fn print_form(what: &str, form: &Form) {
-    println!(
+fn print_form(what: &str, form: &Form) -> anyhow::Result<()> {
+    reportln!(
         "  {what} normal deviations min {:+.4} mm, max {:+.4} mm, RMS {:.4} mm, zone {:.4} mm (twice the largest)",
         form.min_mm, form.max_mm, form.rms_mm, form.zone_mm
-    );
+    )?;
+    Ok(())
 }
 
 fn write_deviations(

@@ -3,6 +3,7 @@
 
 use std::fmt;
 use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The exit codes, as `zeroset --help` lists them after the commands.
 pub const EXIT_CODES: &str = "\
@@ -14,7 +15,7 @@ Exit codes:
   4    inspect: the part was measured and is outside its tolerance (the report is written)
   5    teach or inspect: the job was aborted (`zeroset abort`)
   6    teach or inspect: the job stopped on a fault and waits for `zeroset clear`; follow it with `zeroset watch`
-  141  standard output was closed (e.g. `| head`): the command stopped writing, quietly";
+  141  standard output was closed (`| head`): output stops quietly; fit, deviate, evaluate, mesh, sweep still write files";
 
 const FAILED: u8 = 1;
 const CONFIGURATION: u8 = 3;
@@ -51,6 +52,32 @@ pub(crate) fn write_out(text: fmt::Arguments) -> anyhow::Result<()> {
         Ok(()) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(OutputClosed.into()),
         Err(e) => Err(anyhow::Error::new(e).context("cannot write to standard output")),
+    }
+}
+
+/// Set once a [`write_report`] found standard output closed.
+static REPORT_CUT_OFF: AtomicBool = AtomicBool::new(false);
+
+/// Writes a line of a command whose result is a file (a model, deviations, a mesh): a closed standard output does
+/// not stop the work, which would lose the file (`zeroset fit ip ... | head -3`); [`report_cut_off`] ends the
+/// command as cut off once its files are written.
+pub(crate) fn write_report(text: fmt::Arguments) -> anyhow::Result<()> {
+    match write_out(text) {
+        Err(e) if e.is::<OutputClosed>() => {
+            REPORT_CUT_OFF.store(true, Ordering::Relaxed);
+            Ok(())
+        }
+        written => written,
+    }
+}
+
+/// [`OutputClosed`] if a report line could not be written: the command's code is then 141, as for any tool whose
+/// reader went away.
+pub(crate) fn report_cut_off() -> anyhow::Result<()> {
+    if REPORT_CUT_OFF.load(Ordering::Relaxed) {
+        Err(OutputClosed.into())
+    } else {
+        Ok(())
     }
 }
 

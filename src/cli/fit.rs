@@ -98,7 +98,7 @@ enum NormalsArg {
 pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let file = read_point_file(&args.points)?;
-    warn_of_isolated_points(&file);
+    warn_of_isolated_points(&file)?;
     let options = FitOptions::new(args.degree.unwrap_or(DEFAULT_DEGREE), args.method.into());
     let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
@@ -118,8 +118,8 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             let normals = pca_normals(&points);
             let fitted = fit_ip(&points, &normals, &options)
                 .map_err(|e| anyhow!("{}: {e}", all_rows(&args.points, points.len())))?;
-            print_fit(&args.points, "surface", &fitted, &points, args.tolerance);
-            warn_if_profiles(&points, args.plane_tolerance);
+            print_fit(&args.points, "surface", &fitted, &points, args.tolerance)?;
+            warn_if_profiles(&points, args.plane_tolerance)?;
             (
                 ReferenceModel::Surface(FittedIp::from(fitted.clone())),
                 fitted.method,
@@ -142,11 +142,11 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     }
     file.save(&args.out)?;
-    println!(
+    reportln!(
         "wrote {} ({:.2} s)",
         args.out.display(),
         started.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }
 
@@ -182,14 +182,14 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
         .filter(|j| j.sharp)
         .map(|j| format!("({:.3}, {:.3})", j.point[0], j.point[1]))
         .collect();
-    println!(
+    reportln!(
         "{}: {} sharp edge(s) at {} mm: fitted face by face, {} faces joined at the edges (--edges none for one \
          polynomial)",
         args.points.display(),
         edges.len(),
         edges.join(", "),
         fitted.faces.len()
-    );
+    )?;
     let faces = fitted
         .faces
         .iter()
@@ -205,13 +205,13 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
                 .collect();
             format!("chosen by held-out RMS, {}", scores.join(", "))
         };
-        println!(
+        reportln!(
             "  face {j}: degree {} ({chosen}), {} points, RMS {:.4} mm, max {:.4} mm",
             face.model.degree(),
             points,
             face.stats.rms_distance_mm,
             face.stats.max_distance_mm
-        );
+        )?;
     }
     if !fitted.joint_gaps_mm.is_empty() {
         let gaps: Vec<String> = fitted
@@ -219,17 +219,18 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
             .iter()
             .map(|g| format!("{:.2} um", g * 1000.0))
             .collect();
-        println!(
+        reportln!(
             "  at the smooth joints the faces' curves pass {} apart (the model's step there)",
             gaps.join(", ")
-        );
+        )?;
     }
     let faced = FacedIp::of(fitted, points);
     let stats = faced.fit.expect("a profile of faces' statistics");
-    println!(
+    reportln!(
         "  distance of the fitted points to the joined faces: RMS {:.4} mm, max {:.4} mm",
-        stats.rms_distance_mm, stats.max_distance_mm
-    );
+        stats.rms_distance_mm,
+        stats.max_distance_mm
+    )?;
     if let Some(tolerance) = args.tolerance {
         if stats.max_distance_mm > tolerance {
             bail!(
@@ -280,7 +281,7 @@ fn one_polynomial(
             (fitted, scores, chosen)
         }
     };
-    print_fit(path, "profile", &fitted, points, args.tolerance);
+    print_fit(path, "profile", &fitted, points, args.tolerance)?;
     if !scores.is_empty() {
         let scores: Vec<String> = scores
             .iter()
@@ -295,10 +296,10 @@ fn one_polynomial(
                  or footless point; see"
             )
         };
-        println!(
+        reportln!(
             "  degree {degree} {why} the RMS distance of the points held out of the fit ({}); --degree gives one",
             scores.join(", ")
-        );
+        )?;
     }
     Ok((
         ReferenceModel::Profile(FittedIp::from(fitted.clone())),
@@ -386,7 +387,7 @@ fn fit_stack(
             &fitted,
             &yz,
             args.tolerance,
-        );
+        )?;
         profiles.push(StackProfile {
             x,
             fitted: FittedIp::from(fitted),
@@ -428,49 +429,53 @@ fn print_fit<const N: usize>(
     fitted: &Fitted<N>,
     points: &[SVector<f64, N>],
     tolerance_mm: Option<f64>,
-) {
+) -> anyhow::Result<()> {
     let s = &fitted.stats;
     let at: Vec<String> = s
         .max_distance_at
         .iter()
         .map(|c| format!("{c:.3}"))
         .collect();
-    println!(
+    reportln!(
         "fitted a degree-{} implicit polynomial ({what}) to {} points of {} by {}",
         fitted.model.degree(),
         s.points,
         path.display(),
         fitted.method.describe()
-    );
-    println!(
+    )?;
+    reportln!(
         "  distance of the fitted points to the model: RMS {:.4} mm, max {:.4} mm at ({}) mm",
         s.rms_distance_mm,
         s.max_distance_mm,
         at.join(", ")
-    );
-    println!(
+    )?;
+    reportln!(
         "  condition number {:.1e}; 3L offsets {:.3} to {:.3} mm; {} refinement iterations",
-        s.condition_number, s.offset_min_mm, s.offset_max_mm, s.refinement_iterations
-    );
-    println!(
+        s.condition_number,
+        s.offset_min_mm,
+        s.offset_max_mm,
+        s.refinement_iterations
+    )?;
+    reportln!(
         "  zero set: {} component(s) within twice the data's box, {} spurious branch(es) beside the data",
         s.zero_set_components, s.branches_beside_data
-    );
+    )?;
     let scatter = fit_sanity::scatter_mm(points);
     for doubt in fit_sanity::doubts(s, scatter, &fitted.domain, tolerance_mm) {
-        println!("  warning: {doubt}");
+        reportln!("  warning: {doubt}")?;
     }
+    Ok(())
 }
 
 /// Points that stand far from all others are named by their lines before the fit: an export error, or a touch of
 /// something else, pulls the whole model.
-fn warn_of_isolated_points(file: &PointFile) {
+fn warn_of_isolated_points(file: &PointFile) -> anyhow::Result<()> {
     let isolated = match &file.points {
         PointSet::Profile(points) => fit_sanity::isolated_points(points),
         PointSet::Spatial(points) => fit_sanity::isolated_points(points),
     };
     if isolated.is_empty() {
-        return;
+        return Ok(());
     }
     let lines: Vec<String> = isolated
         .iter()
@@ -478,17 +483,18 @@ fn warn_of_isolated_points(file: &PointFile) {
         .map(|&i| file.lines[i].to_string())
         .collect();
     let more = if isolated.len() > 10 { ", ..." } else { "" };
-    println!(
+    reportln!(
         "warning: {} point(s) stand far from all the others (line {}{more}): an export error or a touch of \
          something else? remove them and fit again",
         isolated.len(),
         lines.join(", ")
-    );
+    )?;
+    Ok(())
 }
 
 /// 3-D points fitted as one surface that lie in parallel planes of constant x are profiles: say so, and that
 /// `--stack` fits them as such.
-fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) {
+fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) -> anyhow::Result<()> {
     let planes = group_into_planes(points, plane_tolerance);
     let profiles = planes.len() >= 2
         && planes
@@ -496,13 +502,14 @@ fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) {
             .all(|(_, plane)| plane.len() >= MIN_PROFILE_POINTS);
     if profiles {
         let xs: Vec<String> = planes.iter().map(|(x, _)| format!("{x:.3}")).collect();
-        println!(
+        reportln!(
             "  warning: the points lie in {} parallel planes of constant x (x = {} mm): they are profiles, \
              which one surface does not model; fit them with --stack",
             planes.len(),
             xs.join(", ")
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// A plane of constant x holding at least this many points is a scanned profile, not a scatter of surface points.

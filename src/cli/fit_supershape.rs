@@ -85,17 +85,18 @@ pub fn run(args: &FitSupershapeArgs) -> anyhow::Result<()> {
     let file = ModelFile::new(method, ReferenceModel::Supershape { solid, fit: stats });
     file.save(&args.out)?;
     match stats {
-        Some(s) => println!(
+        Some(s) => reportln!(
             "  exact distances of the points: RMS {:.4} mm, max {:.4} mm",
-            s.rms_distance_mm, s.max_distance_mm
+            s.rms_distance_mm,
+            s.max_distance_mm
         ),
-        None => println!("  some points have no exact distance to the model"),
-    }
-    println!(
+        None => reportln!("  some points have no exact distance to the model"),
+    }?;
+    reportln!(
         "wrote {} ({:.2} s)",
         args.out.display(),
         started.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }
 
@@ -115,7 +116,7 @@ fn whole(
     let recovered =
         recover(points, options).map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
     let (primitives, booleans) = recovered.solid.root().counts();
-    println!(
+    reportln!(
         "{what} of {}: {} points, {primitives} primitives and {booleans} Booleans, symmetry {},{}, global error \
          (eq. 15) {:.4e} mm^3",
         args.points.display(),
@@ -123,8 +124,8 @@ fn whole(
         recovered.symmetry[0],
         recovered.symmetry[1],
         recovered.global_error
-    );
-    describe(args, &recovered);
+    )?;
+    describe(args, &recovered)?;
     let method = format!("{what} recovery (seed 001): {}", how_found(&recovered));
     Ok((recovered.solid, method))
 }
@@ -147,25 +148,25 @@ fn segmented(
     })
     .map_err(|e| anyhow::anyhow!("{}: {e}", args.points.display()))?;
     let (primitives, booleans) = object.solid.root().counts();
-    println!(
+    reportln!(
         "{} segments of {} joined by R_p union: {} points, {primitives} primitives and {booleans} Booleans, \
          global error (eq. 15) {:.4e} mm^3",
         object.segments.len(),
         args.points.display(),
         segments.iter().map(|s| s.points.len()).sum::<usize>(),
         object.global_error
-    );
+    )?;
     let mut found = Vec::new();
     for (segment, scanned) in object.segments.iter().zip(segments) {
-        println!(
+        reportln!(
             "  segment '{}': {} points, symmetry {},{}, global error {:.4e} mm^3",
             segment.label,
             scanned.points.len(),
             segment.recovered.symmetry[0],
             segment.recovered.symmetry[1],
             segment.recovered.global_error
-        );
-        describe(args, &segment.recovered);
+        )?;
+        describe(args, &segment.recovered)?;
         found.push(format!(
             "segment '{}': {}",
             segment.label,
@@ -194,22 +195,23 @@ fn how_found(recovered: &Recovered) -> String {
 }
 
 /// One recovery's envelope, superquadric and holes, as printed lines.
-fn describe(args: &FitSupershapeArgs, recovered: &Recovered) {
+fn describe(args: &FitSupershapeArgs, recovered: &Recovered) -> anyhow::Result<()> {
     if args.superquadric {
         let (shape, _) = &recovered.envelope;
-        println!(
+        reportln!(
             "  superquadric: sizes {:.4}, {:.4}, {:.4} mm, epsilon1 {:.4} (along its axis), epsilon2 {:.4} (across)",
             shape.scale[0],
             shape.scale[1],
             shape.scale[2],
             2.0 / shape.r2.n1,
             2.0 / shape.r1.n1
-        );
+        )?;
     }
     let through = recovered.holes.iter().filter(|h| h.through).count();
-    println!(
+    reportln!(
         "  envelope: RMS radial distance {:.4} mm; {} hole(s) ({through} through)",
         recovered.rms_radial_mm,
         recovered.holes.len()
-    );
+    )?;
+    Ok(())
 }

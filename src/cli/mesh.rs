@@ -52,7 +52,7 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     mesh.write_to(&mut bytes, format)?;
     // Atomically, so that a reader (a slicer, a viewer) never sees half a mesh.
     write_atomically(&args.out, &bytes)?;
-    println!(
+    reportln!(
         "wrote {}: {} vertices, {} triangles, {}, volume {:.3} mm^3, area {:.3} mm^2, cell {cell:.3} mm, every vertex \
          within |F| < {:e} ({:.2} s)",
         args.out.display(),
@@ -63,6 +63,6 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
         mesh.area(),
         args.epsilon,
         started.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }

@@ -9,6 +9,14 @@ macro_rules! outln {
     };
 }
 
+/// `println!` for the lines of a command whose result is a file: a closed standard output ends it with code 141 only
+/// after its work is done and its files written ([`exit::write_report`]). Returns `anyhow::Result<()>`.
+macro_rules! reportln {
+    ($($arg:tt)*) => {
+        $crate::cli::exit::write_report(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
 /// [`outln!`] without the newline.
 macro_rules! out {
     ($($arg:tt)*) => {
@@ -141,7 +149,7 @@ impl From<DistanceArg> for DistanceMethod {
 
 /// Runs the command line; the error is one line for the operator.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {
+    let ran = match cli.command {
         Command::Fit(FitCommand::Ip(args)) => fit::run(&args),
         Command::Fit(FitCommand::Supershape(args)) => fit_supershape::run(&args),
         Command::Deviate(args) => deviate::run(&args),
@@ -169,7 +177,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Abort(station) => station::simple(&station, Request::Abort),
         Command::Clear(station) => station::simple(&station, Request::Clear),
         Command::Report(args) => station::report(&args),
-    }
+    };
+    ran.and_then(|()| exit::report_cut_off())
 }
 
 /// "FILE: lines 2-N" for problems of a whole point set (the header is line 1).

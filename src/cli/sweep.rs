@@ -49,7 +49,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let sweep = sweep_plan(&config, &args.part).map_err(anyhow::Error::msg)?;
     let margin = config.safety.move_margin_mm;
     // The chord tolerance to the micrometre: the mesh's error is no finer than that.
-    outln!(
+    reportln!(
         "part {}: {} moves of its inspection checked against the taught model ({} triangles, chord tolerance \
          {:.3} mm); the stylus as the largest the station accepts: ball radius {} mm ([safety] max_ball_radius_mm), \
          shank radius {} mm, length {} mm; margin {margin} mm; distances in mm",
@@ -61,7 +61,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         sweep.stylus.shank.radius_mm,
         sweep.stylus.shank.length_mm,
     )?;
-    outln!(
+    reportln!(
         "{:>5}  {:<10} {:<8} {:<24} {:>10}  {:<6}  closest part point",
         "move",
         "instance",
@@ -77,7 +77,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         let (instance, profile) = names(&sweep.plan, checked);
         let c = &checked.clearance;
         let verdict = verdict(checked, margin);
-        outln!(
+        reportln!(
             "{index:>5}  {instance:<10} {profile:<8} {:<24} {:>10.3}  {:<6}  ({:.3}, {:.3}, {:.3}) {verdict}",
             checked.planned.kind.describe(),
             c.min_distance_mm,
@@ -103,7 +103,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write {}", table.display()))?;
     let svg = args.out.join("silhouette.svg");
     let pieces = write_silhouette(&sweep, args.eye, &svg)?;
-    outln!(
+    reportln!(
         "wrote {} and {} ({pieces} silhouette components)",
         table.display(),
         svg.display()

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use zeroset_sim::naca::Naca4;
 
-use crate::support::{config, deviate, fit_ip, mean, naca_csv};
+use crate::support::{config, deviate, fit_ip, mean, naca_csv, zeroset_with_stdout_closed};
 
 /// The exact deviations of a point file, every point required to have one.
 fn exact_deviations(model: &std::path::Path, points: &str, out: &std::path::Path) -> Vec<f64> {
@@ -75,6 +75,45 @@ fn blades_b_and_c_deviate_by_the_simulated_0_8_mm_and_blade_a_by_its_noise() {
             "blade {blade}: a point off by more than 10 um"
         );
     }
+
+    // A closed standard output (`| head` with its lines) ends each offline command quietly, with the code of a
+    // program cut off by it, after any file it was asked for is written.
+    let points = config("profiles/seed003-profile3-blade-b.csv");
+    let refit = dir.path().join("refit.json");
+    let deviations = dir.path().join("closed.csv");
+    for args in [
+        vec![
+            "fit",
+            "ip",
+            "--points",
+            &points,
+            "--degree",
+            "4",
+            "--out",
+            refit.to_str().unwrap(),
+        ],
+        vec![
+            "deviate",
+            "--model",
+            model.to_str().unwrap(),
+            "--points",
+            &points,
+            "--out",
+            deviations.to_str().unwrap(),
+        ],
+        vec![
+            "evaluate",
+            "--model",
+            model.to_str().unwrap(),
+            "--points",
+            &points,
+        ],
+    ] {
+        let run = zeroset_with_stdout_closed(&args);
+        assert_eq!(run.code, Some(141), "zeroset {args:?}: {}", run.stderr);
+        assert_eq!(run.stderr, "", "zeroset {args:?}");
+    }
+    assert!(refit.exists() && deviations.exists());
 }
 
 #[test]

@@ -48,6 +48,25 @@ pub fn zeroset(args: &[&str]) -> Run {
     }
 }
 
+/// Runs `zeroset ARGS` with its standard output already closed, as `| head` leaves it once it has its lines (closed
+/// before the start, so that a quick command cannot write all it has into the pipe's buffer first).
+pub fn zeroset_with_stdout_closed(args: &[&str]) -> Run {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let output = Command::new(env!("CARGO_BIN_EXE_zeroset"))
+        .args(args)
+        .current_dir(repo())
+        .stdout(writer)
+        .output()
+        .expect("the zeroset binary runs");
+    Run {
+        success: output.status.success(),
+        code: output.status.code(),
+        stdout: String::new(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
 /// Runs and insists on success, showing what it printed otherwise.
 pub fn zeroset_ok(args: &[&str]) -> String {
     let run = zeroset(args);
