@@ -17,10 +17,11 @@ pub struct Supershape {
     pub scale: [f64; 3],
 }
 
-/// The latitude phi of seed 000 eq. 8 for a point of the unscaled shape, with the radii r1(theta),
-/// r2(phi) and their derivatives.
+/// The latitude phi of seed 000 eq. 8 for a point of the unscaled shape (as its cos and sin), with the radii
+/// r1(theta), r2(phi) and, when asked for, their derivatives (else 0).
 struct Angles {
-    phi: f64,
+    cos_phi: f64,
+    sin_phi: f64,
     r1: f64,
     dr1: f64,
     r2: f64,
@@ -68,7 +69,7 @@ impl Supershape {
     /// I on the surface it equals 1 - t^2.
     pub fn implicit(&self, p: &Point3<f64>) -> f64 {
         let q = self.unscaled(p);
-        let a = self.angles(&q);
+        let a = self.angles(&q, false);
         let rho2 = q.x * q.x + q.y * q.y;
         1.0 - (rho2 + a.r1 * a.r1 * q.z * q.z) / (a.r1 * a.r1 * a.r2 * a.r2)
     }
@@ -77,8 +78,8 @@ impl Supershape {
     /// surface point on the half-line [OP): 1 - |P| / (r2 sqrt(cos^2 phi (r1^2 - 1) + 1)).
     pub fn radial(&self, p: &Point3<f64>) -> f64 {
         let q = self.unscaled(p);
-        let a = self.angles(&q);
-        let spread = a.phi.cos().powi(2) * (a.r1 * a.r1 - 1.0) + 1.0;
+        let a = self.angles(&q, false);
+        let spread = a.cos_phi * a.cos_phi * (a.r1 * a.r1 - 1.0) + 1.0;
         1.0 - q.coords.norm() / (a.r2 * spread.sqrt())
     }
 
@@ -86,7 +87,7 @@ impl Supershape {
     /// through the angles of eq. 8. Not defined on the z axis, where theta is not.
     pub fn implicit_gradient(&self, p: &Point3<f64>) -> Vector3<f64> {
         let q = self.unscaled(p);
-        let a = self.angles(&q);
+        let a = self.angles(&q, true);
         let (d_theta, d_phi) = self.angle_gradients(&q, &a);
         let rho2 = q.x * q.x + q.y * q.y;
         let (r1s, r2s) = (a.r1 * a.r1, a.r2 * a.r2);
@@ -110,9 +111,9 @@ impl Supershape {
     /// (the distance search evaluates both at every Newton step).
     pub fn radial_and_gradient(&self, p: &Point3<f64>) -> (f64, Vector3<f64>) {
         let q = self.unscaled(p);
-        let a = self.angles(&q);
+        let a = self.angles(&q, true);
         let (d_theta, d_phi) = self.angle_gradients(&q, &a);
-        let (sin_phi, cos_phi) = a.phi.sin_cos();
+        let (sin_phi, cos_phi) = (a.sin_phi, a.cos_phi);
         let spread = cos_phi * cos_phi * (a.r1 * a.r1 - 1.0) + 1.0;
         let norm2 = q.coords.norm_squared();
         let t = norm2.sqrt() / (a.r2 * spread.sqrt());
@@ -139,15 +140,31 @@ impl Supershape {
     }
 
     /// Seed 000 eq. 8: theta = atan(y / x) and tan phi = z r1(theta) cos(theta) / x. Since
-    /// x = rho cos(theta) with rho = sqrt(x^2 + y^2), the latter is tan phi = z r1 / rho, evaluated
-    /// with atan2 so that it holds in every quadrant and at x = 0.
-    fn angles(&self, q: &Point3<f64>) -> Angles {
-        let theta = q.y.atan2(q.x);
-        let (r1, dr1) = self.r1.radius_and_derivative(theta);
-        let phi = (q.z * r1).atan2(q.x.hypot(q.y));
-        let (r2, dr2) = self.r2.radius_and_derivative(phi);
+    /// x = rho cos(theta) with rho = sqrt(x^2 + y^2), the latter is tan phi = z r1 / rho, in every quadrant and at
+    /// x = 0. The angles are taken as their cos and sin (of atan2's angle: (1, 0) at the origin); a formula with
+    /// m = 4 needs no more, the others turn them by m/4 from the angle itself.
+    fn angles(&self, q: &Point3<f64>, derivatives: bool) -> Angles {
+        let rho = (q.x * q.x + q.y * q.y).sqrt();
+        let (cos_theta, sin_theta) = direction(q.x, q.y, rho);
+        let (sin1, cos1) = self
+            .r1
+            .turned_direction(|| q.y.atan2(q.x), cos_theta, sin_theta);
+        let (r1, dr1) = if derivatives {
+            self.r1.radius_and_derivative_at(cos1, sin1)
+        } else {
+            (self.r1.radius_at(cos1, sin1), 0.0)
+        };
+        let u = q.z * r1;
+        let (cos_phi, sin_phi) = direction(rho, u, (u * u + rho * rho).sqrt());
+        let (sin2, cos2) = self.r2.turned_direction(|| u.atan2(rho), cos_phi, sin_phi);
+        let (r2, dr2) = if derivatives {
+            self.r2.radius_and_derivative_at(cos2, sin2)
+        } else {
+            (self.r2.radius_at(cos2, sin2), 0.0)
+        };
         Angles {
-            phi,
+            cos_phi,
+            sin_phi,
             r1,
             dr1,
             r2,
@@ -166,6 +183,15 @@ impl Supershape {
         let d_rho = Vector3::new(q.x / rho, q.y / rho, 0.0);
         let d_phi = (d_u * rho - d_rho * u) / (u * u + rho2);
         (d_theta, d_phi)
+    }
+}
+
+/// cos and sin of atan2(y, x), given the length of (x, y): (1, 0) at the origin, as atan2(0, 0) = 0.
+fn direction(x: f64, y: f64, length: f64) -> (f64, f64) {
+    if length > 0.0 {
+        (x / length, y / length)
+    } else {
+        (1.0, 0.0)
     }
 }
 
@@ -214,6 +240,66 @@ mod tests {
                 )
             })
         })
+    }
+
+    /// Eq. 7 as printed, every angle by atan2 and every power by powf: what the fast paths (m = 4 read from
+    /// the direction, integer exponents by multiplication) must reproduce.
+    fn radial_as_printed(shape: &Supershape, p: &Point3<f64>) -> f64 {
+        let r = |f: &Superformula, angle: f64| {
+            let (sin, cos) = (f.m * angle / 4.0).sin_cos();
+            ((cos / f.a).abs().powf(f.n2) + (sin / f.b).abs().powf(f.n3)).powf(-1.0 / f.n1)
+        };
+        let q = Point3::new(
+            p.x / shape.scale[0],
+            p.y / shape.scale[1],
+            p.z / shape.scale[2],
+        );
+        let r1 = r(&shape.r1, q.y.atan2(q.x));
+        let phi = (q.z * r1).atan2(q.x.hypot(q.y));
+        let spread = phi.cos().powi(2) * (r1 * r1 - 1.0) + 1.0;
+        1.0 - q.coords.norm() / (r(&shape.r2, phi) * spread.sqrt())
+    }
+
+    #[test]
+    fn the_fast_paths_give_eq_7_as_printed() {
+        // The shapes above, and a part's cylinder and box-like shapes (m = 4 in both formulas, exponents 2 and
+        // 40), the lobes of the brake hub (m = 5, exponents 7).
+        let mut all = shapes();
+        all.push(Supershape {
+            r1: Superformula::circle(),
+            r2: formula(4.0, 40.0, 40.0, 40.0),
+            scale: [12.0, 12.0, 20.0],
+        });
+        all.push(Supershape {
+            r1: formula(4.0, 40.0, 40.0, 40.0),
+            r2: formula(4.0, 40.0, 40.0, 40.0),
+            scale: [16.0, 2.0, 4.0],
+        });
+        all.push(Supershape {
+            r1: formula(5.0, 2.0, 7.0, 7.0),
+            r2: Superformula::circle(),
+            scale: [3.0; 3],
+        });
+        for shape in &all {
+            for k in 0..500 {
+                let t = k as f64;
+                let p = Point3::new(
+                    (0.37 * t).sin() * 1.3 * shape.scale[0],
+                    (0.71 * t).cos() * 1.1 * shape.scale[1],
+                    (0.13 * t).sin() * 1.2 * shape.scale[2],
+                );
+                let expected = radial_as_printed(shape, &p);
+                let got = shape.radial(&p);
+                assert!(
+                    (got - expected).abs() < 1e-13 * (1.0 + expected.abs()),
+                    "{p}: {got} vs {expected}"
+                );
+                assert!(
+                    (shape.radial_and_gradient(&p).0 - expected).abs()
+                        < 1e-13 * (1.0 + expected.abs())
+                );
+            }
+        }
     }
 
     #[test]
