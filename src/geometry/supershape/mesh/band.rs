@@ -5,7 +5,7 @@
 //! cell that no primitive surface crosses holds no piece of the mesh: only the band around the
 //! sampled surfaces is classified, not the whole box.
 
-use std::collections::HashSet;
+use foldhash::{HashSet, HashSetExt};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Point3, Vector3};

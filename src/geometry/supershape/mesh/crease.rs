@@ -8,7 +8,7 @@
 //! and in a triangle with two split edges the new vertices are joined by an edge that follows the
 //! curve. Curve edges longer than delta are then split at their midpoint pulled onto the curve.
 
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt};
 
 use nalgebra::{Point3, Vector3};
 

@@ -9,7 +9,7 @@
 //! primitive's own function (the tree's value is a product of R-function partials times it, and
 //! cheaper to get exactly): the vertex remembers its primitive for the sharp-edge step.
 
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt};
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
