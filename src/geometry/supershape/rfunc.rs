@@ -93,11 +93,113 @@ impl RFunction {
         };
         (value, dx, sign_y * dy)
     }
+
+    /// Bounds of the R-function's value when each argument is only known to lie in a range [lo, hi], either end
+    /// possibly infinite (a primitive whose box does not hold the point is known only to be outside: (-inf, 0]).
+    /// `Alpha` and an even `P` are non-decreasing in each argument of a union or intersection (their partials,
+    /// 1 +- (x - alpha y) / root and 1 +- (x / norm)^(p-1), lie in [0, 2]), so the bounds are their values at the
+    /// ranges' ends; and they are normalised, so that an argument going to the side that does not decide leaves
+    /// the other: union(x, -inf) = x. `ZeroM` is not monotone (its weight grows with both arguments): `None`.
+    pub fn combine_bounds(self, op: Boolean, x: (f64, f64), y: (f64, f64)) -> Option<(f64, f64)> {
+        let monotone = match self {
+            RFunction::Alpha(alpha) => alpha > -1.0 && alpha <= 1.0,
+            RFunction::P(p) => p >= 2 && p % 2 == 0,
+            RFunction::ZeroM(_) => false,
+        };
+        if !monotone {
+            return None;
+        }
+        let (op, y) = match op {
+            Boolean::Difference => (Boolean::Intersection, (negation(y.1), negation(y.0))),
+            _ => (op, y),
+        };
+        Some((
+            self.combine_to_limit(op, x.0, y.0),
+            self.combine_to_limit(op, x.1, y.1),
+        ))
+    }
+
+    /// The union or intersection with either argument possibly infinite, as the limit of a normalised
+    /// R-function: what decides wins (a union with +inf is +inf), what does not leaves the other argument.
+    fn combine_to_limit(self, op: Boolean, x: f64, y: f64) -> f64 {
+        let deciding = if op == Boolean::Union {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        };
+        if x == deciding || y == deciding {
+            deciding
+        } else if x.is_infinite() {
+            y
+        } else if y.is_infinite() {
+            x
+        } else {
+            self.combine(op, x, y)
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn bounds_over_ranges_hold_every_value_in_them_and_their_limits_at_infinity() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let ops = [Boolean::Union, Boolean::Intersection, Boolean::Difference];
+        for rfunction in [
+            RFunction::Alpha(1.0),
+            RFunction::Alpha(0.0),
+            RFunction::Alpha(-0.5),
+            RFunction::P(2),
+            RFunction::P(4),
+        ] {
+            for op in ops {
+                for _ in 0..200 {
+                    let range = |rng: &mut rand::rngs::StdRng| {
+                        let (a, b): (f64, f64) =
+                            (rng.gen_range(-2.0..2.0), rng.gen_range(-2.0..2.0));
+                        (a.min(b), a.max(b))
+                    };
+                    let (x, y) = (range(&mut rng), range(&mut rng));
+                    let (lo, hi) = rfunction.combine_bounds(op, x, y).unwrap();
+                    for _ in 0..20 {
+                        let value = rfunction.combine(
+                            op,
+                            rng.gen_range(x.0..=x.1),
+                            rng.gen_range(y.0..=y.1),
+                        );
+                        assert!(
+                            value >= lo - 1e-12 && value <= hi + 1e-12,
+                            "{rfunction:?} {op:?} {x:?} {y:?}: {value} not in [{lo}, {hi}]"
+                        );
+                    }
+                }
+                // A primitive known only to be outside, (-inf, 0], beside a value x: the union lies
+                // between x (the primitive far away) and its value at 0, and every far value comes near x.
+                let x = 0.3;
+                let (lo, hi) = rfunction
+                    .combine_bounds(op, (x, x), (f64::NEG_INFINITY, 0.0))
+                    .unwrap();
+                let far = rfunction.combine(op, x, -1e3);
+                let near = rfunction.combine(op, x, 0.0);
+                assert!(
+                    lo <= far.min(near) + 1e-12 && hi >= far.max(near) - 1e-12,
+                    "{rfunction:?} {op:?}"
+                );
+                match op {
+                    Boolean::Union => assert_eq!((lo, hi), (x, near)),
+                    Boolean::Intersection => assert_eq!((lo, hi), (f64::NEG_INFINITY, near)),
+                    Boolean::Difference => assert_eq!((lo, hi), (near, x)),
+                }
+            }
+        }
+        assert_eq!(
+            RFunction::ZeroM(2).combine_bounds(Boolean::Union, (0.0, 1.0), (0.0, 1.0)),
+            None
+        );
+    }
 
     const BRANCHES: [RFunction; 6] = [
         RFunction::Alpha(1.0),

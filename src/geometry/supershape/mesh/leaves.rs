@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::super::csg::{Aabb, Node, NodeKind, Solid};
 use super::super::deform::Deformations;
-use super::super::rfunc::Boolean;
+use super::super::rfunc::{Boolean, RFunction};
 
 /// One primitive of the tree.
 pub(super) struct Leaf<'a> {
@@ -23,7 +23,7 @@ pub(super) struct Leaf<'a> {
 
 enum Expr {
     Leaf(usize),
-    Op(Boolean, Box<Expr>, Box<Expr>),
+    Op(Boolean, RFunction, Box<Expr>, Box<Expr>),
 }
 
 /// The tree as leaves plus the Boolean expression over their signs.
@@ -62,12 +62,39 @@ impl<'a> Leaves<'a> {
     pub fn inside(&self, p: &Point3<f64>) -> bool {
         self.classify(&self.signs(p))
     }
+
+    /// Bounds of the whole tree's implicit function at a model point, from the leaves whose boxes hold it (their
+    /// values, exactly as `Solid::value` computes them) and the others known only to be outside, (-inf, 0]: the
+    /// R-functions are monotone, so their values at the ends bound the tree (see `RFunction::combine_bounds`).
+    /// Most of a part's primitives are far from any one point, and a point on the surface gets bounds as narrow
+    /// as its own primitive's value at a small fraction of the tree's cost. `None` under an R-function that is not
+    /// monotone.
+    pub fn value_bounds(&self, p: &Point3<f64>) -> Option<(f64, f64)> {
+        self.bounds_of(&self.expr, p)
+    }
+
+    fn bounds_of(&self, expr: &Expr, p: &Point3<f64>) -> Option<(f64, f64)> {
+        match expr {
+            Expr::Leaf(i) => {
+                let leaf = &self.leaves[*i];
+                Some(if leaf.bounds.contains(p) {
+                    let value = leaf.value(p);
+                    (value, value)
+                } else {
+                    (f64::NEG_INFINITY, 0.0)
+                })
+            }
+            Expr::Op(op, rfunction, left, right) => {
+                rfunction.combine_bounds(*op, self.bounds_of(left, p)?, self.bounds_of(right, p)?)
+            }
+        }
+    }
 }
 
 fn evaluate(expr: &Expr, signs: &[bool]) -> bool {
     match expr {
         Expr::Leaf(i) => signs[*i],
-        Expr::Op(op, left, right) => {
+        Expr::Op(op, _, left, right) => {
             let (l, r) = (evaluate(left, signs), evaluate(right, signs));
             match op {
                 Boolean::Union => l || r,
@@ -91,14 +118,17 @@ fn flatten<'a>(
     *index += 1;
     match &node.kind {
         NodeKind::Boolean {
-            op, left, right, ..
+            op,
+            rfunction,
+            left,
+            right,
         } => {
             let mut chain = ancestors.to_vec();
             chain.push(&node.place);
             let clip = clip.intersection(&own);
             let l = flatten(left, &chain, clip, bounds, index, leaves);
             let r = flatten(right, &chain, clip, bounds, index, leaves);
-            Expr::Op(*op, Box::new(l), Box::new(r))
+            Expr::Op(*op, *rfunction, Box::new(l), Box::new(r))
         }
         _ => {
             leaves.push(Leaf {
@@ -183,6 +213,46 @@ mod tests {
             inside > total / 20 && inside < total / 2,
             "{inside} of {total}"
         );
+    }
+
+    #[test]
+    fn the_trees_value_lies_within_its_bounds_from_the_leaves_near_a_point() {
+        let solid = brake_hub();
+        let leaves = Leaves::new(&solid);
+        let b = solid.bounds();
+        for i in 0..30 {
+            for j in 0..30 {
+                for k in 0..12 {
+                    let t = Vector3::new(
+                        (i as f64 + 0.3) / 30.0,
+                        (j as f64 + 0.7) / 30.0,
+                        (k as f64 + 0.4) / 12.0,
+                    );
+                    let p = b.min + (b.max - b.min).component_mul(&t);
+                    let value = solid.value(&p);
+                    let (lo, hi) = leaves.value_bounds(&p).expect("R_p is monotone");
+                    assert!(
+                        lo <= value + 1e-12 && value <= hi + 1e-12,
+                        "{p}: {value} not in [{lo}, {hi}]"
+                    );
+                }
+            }
+        }
+        // On the surface the bounds are about as narrow as the value of the primitive the point lies on (at most
+        // twice it, where a union's other side is far): at every vertex of the hub's mesh within a tenth of the
+        // mesh's epsilon (1e-6), so that they prove its check without the tree's value.
+        let mesh =
+            super::super::polygonise(&solid, &super::super::MeshParams::with_cell(2.0)).unwrap();
+        for v in &mesh.vertices {
+            let (lo, hi) = leaves.value_bounds(v).unwrap();
+            let value = solid.value(v);
+            // To the tree's own rounding: x + y + |(x, y)| of a far y cancels to about 1e-16 |y|.
+            assert!(
+                lo - 1e-12 <= value && value <= hi + 1e-12,
+                "{v}: {value} not in [{lo}, {hi}]"
+            );
+            assert!(lo > -1e-7 && hi < 1e-7, "{v}: [{lo}, {hi}]");
+        }
     }
 
     #[test]

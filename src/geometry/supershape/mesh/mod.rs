@@ -22,7 +22,8 @@
 //!    again on the curve. Splits keep the mesh closed.
 //!
 //! Every vertex is then checked on the whole tree's function: |F(v)| < epsilon, or the mesh is
-//! refused. Features thinner than a grid cell can be missed (the mesh stays closed but loses
+//! refused (proved from bounds of F built from the primitives whose boxes hold the vertex, or, where those do not
+//! prove it, by F's value). Features thinner than a grid cell can be missed (the mesh stays closed but loses
 //! them): the cell must resolve the part's thinnest wall and smallest hole.
 
 mod band;
@@ -110,10 +111,18 @@ pub fn polygonise(solid: &Solid, params: &MeshParams) -> Result<TriMesh, MeshErr
     let cells = band::band(&leaves, &grid);
     let mut surface = tetra::march(&leaves, &grid, &cells, epsilon)?;
     crease::sharpen(&leaves, solid, &mut surface, epsilon, delta);
-    // Every vertex on the whole tree, on every core; the first one off the surface is reported.
+    // Every vertex on the whole tree, on every core; the first one off the surface is reported. Its value is
+    // bounded from the primitives near it (`Leaves::value_bounds`), within half of epsilon (the other half for the
+    // tree's own rounding); only a vertex whose bounds do not prove it is evaluated on the whole tree.
+    let proved = |v: &Point3<f64>| {
+        leaves
+            .value_bounds(v)
+            .is_some_and(|(lo, hi)| lo > -0.5 * epsilon && hi < 0.5 * epsilon)
+    };
     let off_surface = surface
         .vertices
         .par_iter()
+        .filter(|v| !proved(v))
         .map(|v| (*v, solid.value(v)))
         .find_first(|(_, value)| value.is_nan() || value.abs() >= epsilon);
     if let Some((at, value)) = off_surface {
