@@ -40,12 +40,16 @@ impl Supershape {
 
     /// The surface point of seed 000 eq. 5 at longitude `theta` and latitude `phi`, scaled.
     pub fn point(&self, theta: f64, phi: f64) -> Point3<f64> {
-        let r1 = self.r1.radius(theta);
-        let r2 = self.r2.radius(phi);
+        let (sin_theta, cos_theta) = theta.sin_cos();
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let (sin1, cos1) = self.r1.turned_direction(|| theta, cos_theta, sin_theta);
+        let (sin2, cos2) = self.r2.turned_direction(|| phi, cos_phi, sin_phi);
+        let r1 = self.r1.radius_at(cos1, sin1);
+        let r2 = self.r2.radius_at(cos2, sin2);
         Point3::new(
-            self.scale[0] * r1 * r2 * theta.cos() * phi.cos(),
-            self.scale[1] * r1 * r2 * theta.sin() * phi.cos(),
-            self.scale[2] * r2 * phi.sin(),
+            self.scale[0] * r1 * r2 * cos_theta * cos_phi,
+            self.scale[1] * r1 * r2 * sin_theta * cos_phi,
+            self.scale[2] * r2 * sin_phi,
         )
     }
 

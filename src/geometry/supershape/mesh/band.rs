@@ -5,7 +5,6 @@
 //! cell that no primitive surface crosses holds no piece of the mesh: only the band around the
 //! sampled surfaces is classified, not the whole box.
 
-use foldhash::{HashSet, HashSetExt};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Point3, Vector3};
@@ -51,6 +50,26 @@ impl Grid {
         Some(ijk)
     }
 
+    /// Cells along each axis.
+    fn cells_along(&self) -> [u64; 3] {
+        self.dims.map(|d| d - 1)
+    }
+
+    fn cell_count(&self) -> u64 {
+        self.cells_along().iter().product()
+    }
+
+    /// A cell's id: its place in the order z, then y, then x (that of its lowest vertex's id).
+    fn cell_id(&self, ijk: [u64; 3]) -> u64 {
+        let [nx, ny, _] = self.cells_along();
+        ijk[0] + nx * (ijk[1] + ny * ijk[2])
+    }
+
+    fn cell_ijk(&self, id: u64) -> [u64; 3] {
+        let [nx, ny, _] = self.cells_along();
+        [id % nx, (id / nx) % ny, id / (nx * ny)]
+    }
+
     /// Whether a cell has all its vertices inside the grid.
     fn has_cell(&self, ijk: [i64; 3]) -> bool {
         (0..3).all(|axis| ijk[axis] >= 0 && (ijk[axis] as u64) + 1 < self.dims[axis])
@@ -64,77 +83,137 @@ const BASE_FACE: usize = 4;
 /// Depth limit of the patch refinement: 2^14 subdivisions of a base patch.
 const MAX_DEPTH: u32 = 14;
 
-/// Every cell within one cell of a parametric sample of a primitive's surface, sorted. Patches
-/// are split until their corners are closer than half a cell, so every surface point lies within
-/// half a cell of a sample, and every cell the surface crosses is a neighbour of a sampled cell.
-/// The primitives are sampled on every core, each into its own set.
+/// Every cell within one cell of a parametric sample of a primitive's surface, in the order of their lowest
+/// vertices' ids (z, then y, then x). Patches are split until their corners are closer than half a cell, so
+/// every surface point lies within half a cell of a sample, and every cell the surface crosses is a neighbour
+/// of a sampled cell. The base patches of every primitive are sampled on every core (one large primitive, the
+/// rim of a hub, would otherwise keep one core busy alone); the cells are marked in bit sets over the grid.
 pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
-    let sampled: HashSet<[u64; 3]> = leaves
+    let patches: Vec<(usize, BasePatch)> = leaves
         .leaves
+        .iter()
+        .enumerate()
+        .flat_map(|(i, leaf)| base_patches(leaf).into_iter().map(move |patch| (i, patch)))
+        .collect();
+    let cell_count = grid.cell_count();
+    let sampled = patches
         .par_iter()
-        .map(|leaf| sampled_cells(leaf, grid))
-        .reduce(HashSet::new, |mut all, more| {
-            all.extend(more);
-            all
-        });
-    let mut band = HashSet::with_capacity(sampled.len() * 4);
-    for c in &sampled {
+        .fold(
+            || Cells::new(cell_count),
+            |mut cells, (i, patch)| {
+                sample_base_patch(&leaves.leaves[*i], patch, grid, &mut cells);
+                cells
+            },
+        )
+        .reduce(|| Cells::new(cell_count), Cells::union);
+    let mut band = Cells::new(cell_count);
+    for c in sampled.iter().map(|id| grid.cell_ijk(id)) {
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     let n = [c[0] as i64 + dx, c[1] as i64 + dy, c[2] as i64 + dz];
                     if grid.has_cell(n) {
-                        band.insert(n.map(|v| v as u64));
+                        band.insert(grid.cell_id(n.map(|v| v as u64)));
                     }
                 }
             }
         }
     }
-    let mut cells: Vec<[u64; 3]> = band.into_iter().collect();
-    cells.sort_unstable_by_key(|c| (c[2], c[1], c[0]));
-    cells
+    band.iter().map(|id| grid.cell_ijk(id)).collect()
 }
 
-/// The cells holding a parametric sample of one primitive's surface within its clip box.
-fn sampled_cells(leaf: &Leaf, grid: &Grid) -> HashSet<[u64; 3]> {
-    let mut sampled = HashSet::new();
-    let clip = leaf.clip;
-    let mut mark = |p: &Point3<f64>| {
-        if clip.contains(p) {
-            if let Some(c) = grid.cell_of(p) {
-                sampled.insert(c);
-            }
-        }
-    };
+/// A set of the grid's cells as bits, by cell id: one bit a cell where a hash set spent tens of bytes and a hash.
+struct Cells(Vec<u64>);
+
+impl Cells {
+    fn new(count: u64) -> Self {
+        Self(vec![0; count.div_ceil(64) as usize])
+    }
+
+    fn insert(&mut self, id: u64) {
+        self.0[(id / 64) as usize] |= 1 << (id % 64);
+    }
+
+    fn union(mut self, other: Self) -> Self {
+        self.0.iter_mut().zip(&other.0).for_each(|(a, b)| *a |= b);
+        self
+    }
+
+    /// The ids in increasing order.
+    fn iter(&self) -> impl Iterator<Item = u64> + '_ {
+        self.0.iter().enumerate().flat_map(|(word, &bits)| {
+            (0..64)
+                .filter(move |bit| bits & (1 << bit) != 0)
+                .map(move |bit| word as u64 * 64 + bit)
+        })
+    }
+}
+
+/// One patch of a primitive's base parametric grid: a supershape's (theta, phi) rectangle, or a box face's
+/// (u, v) rectangle on face `axis`/`side`.
+enum BasePatch {
+    Supershape([f64; 4]),
+    Face {
+        axis: usize,
+        side: f64,
+        rect: [f64; 4],
+    },
+}
+
+fn base_patches(leaf: &Leaf) -> Vec<BasePatch> {
     match &leaf.node().kind {
-        NodeKind::Supershape { shape } => {
-            let surface = |theta: f64, phi: f64| leaf.to_model(&shape.point(theta, phi));
+        NodeKind::Supershape { .. } => {
             let (nt, np) = BASE_SUPERSHAPE;
             let (dt, dp) = (2.0 * PI / nt as f64, PI / np as f64);
-            for i in 0..nt {
-                for j in 0..np {
+            (0..nt)
+                .flat_map(|i| (0..np).map(move |j| (i, j)))
+                .map(|(i, j)| {
                     let (t0, p0) = (-PI + i as f64 * dt, -FRAC_PI_2 + j as f64 * dp);
-                    sample_patch(&surface, [t0, t0 + dt, p0, p0 + dp], grid.cell, &mut mark);
-                }
-            }
+                    BasePatch::Supershape([t0, t0 + dt, p0, p0 + dp])
+                })
+                .collect()
         }
-        NodeKind::Cuboid { half_extents } => {
+        NodeKind::Cuboid { .. } => {
+            let d = 2.0 / BASE_FACE as f64;
+            let mut patches = Vec::new();
             for axis in 0..3 {
                 for side in [-1.0, 1.0] {
-                    let surface = |u: f64, v: f64| face_point(leaf, half_extents, axis, side, u, v);
-                    let d = 2.0 / BASE_FACE as f64;
                     for i in 0..BASE_FACE {
                         for j in 0..BASE_FACE {
                             let (u0, v0) = (-1.0 + i as f64 * d, -1.0 + j as f64 * d);
-                            sample_patch(&surface, [u0, u0 + d, v0, v0 + d], grid.cell, &mut mark);
+                            let rect = [u0, u0 + d, v0, v0 + d];
+                            patches.push(BasePatch::Face { axis, side, rect });
                         }
                     }
                 }
             }
+            patches
         }
         NodeKind::Boolean { .. } => unreachable!("leaves are primitives"),
     }
-    sampled
+}
+
+/// Marks the cells holding a parametric sample of one base patch of a primitive's surface within its clip box.
+fn sample_base_patch(leaf: &Leaf, patch: &BasePatch, grid: &Grid, cells: &mut Cells) {
+    let clip = leaf.clip;
+    let mut mark = |p: &Point3<f64>| {
+        if clip.contains(p) {
+            if let Some(c) = grid.cell_of(p) {
+                cells.insert(grid.cell_id(c));
+            }
+        }
+    };
+    match (&leaf.node().kind, patch) {
+        (NodeKind::Supershape { shape }, BasePatch::Supershape(rect)) => {
+            let surface = |theta: f64, phi: f64| leaf.to_model(&shape.point(theta, phi));
+            sample_patch(&surface, *rect, grid.cell, &mut mark);
+        }
+        (NodeKind::Cuboid { half_extents }, BasePatch::Face { axis, side, rect }) => {
+            let surface = |u: f64, v: f64| face_point(leaf, half_extents, *axis, *side, u, v);
+            sample_patch(&surface, *rect, grid.cell, &mut mark);
+        }
+        _ => unreachable!("a leaf's base patches are of its own kind"),
+    }
 }
 
 /// A point of face `axis`/`side` of a box at face coordinates (u, v) in [-1, 1], in the model frame.
