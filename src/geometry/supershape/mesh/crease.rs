@@ -11,6 +11,7 @@
 use foldhash::{HashMap, HashMapExt};
 
 use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
 
 use super::super::csg::Solid;
 use super::leaves::Leaves;
@@ -35,7 +36,8 @@ pub(super) fn sharpen(
         let (pa, pb) = (surface.vertices[a], surface.vertices[b]);
         let start = balance_point(leaves, i, j, pa, pb);
         let point = curve_point(leaves, i, j, start, epsilon)?;
-        acceptable(solid, epsilon, &point, &start, (pb - pa).norm()).then_some((point, (i, j)))
+        acceptable(leaves, solid, epsilon, &point, &start, (pb - pa).norm())
+            .then_some((point, (i, j)))
     });
     apply_splits(surface, splits);
     // Curve edges longer than delta are split on the curve.
@@ -52,7 +54,7 @@ pub(super) fn sharpen(
             }
             let start = nalgebra::center(&pa, &pb);
             let point = curve_point(leaves, i, j, start, epsilon)?;
-            acceptable(solid, epsilon, &point, &start, length).then_some((point, (i, j)))
+            acceptable(leaves, solid, epsilon, &point, &start, length).then_some((point, (i, j)))
         });
         if splits.is_empty() {
             break;
@@ -64,35 +66,42 @@ pub(super) fn sharpen(
 /// A split point is kept if the whole tree vanishes there (the curve point is not buried inside
 /// another primitive) and it stays near the edge it replaces (so no triangle folds over).
 fn acceptable(
+    leaves: &Leaves,
     solid: &Solid,
     epsilon: f64,
     point: &Point3<f64>,
     start: &Point3<f64>,
     length: f64,
 ) -> bool {
-    (point - start).norm() <= 0.5 * length && solid.value(point).abs() < epsilon
+    (point - start).norm() <= 0.5 * length && vanishes(leaves, solid, epsilon, point)
+}
+
+/// |F| < epsilon for the whole tree at `point`: proved from the bounds of its primitives near it, as the mesh's
+/// final check does, else by the tree's value.
+fn vanishes(leaves: &Leaves, solid: &Solid, epsilon: f64, point: &Point3<f64>) -> bool {
+    leaves.proves_on_surface(point, epsilon) || solid.value(point).abs() < epsilon
 }
 
 type Split = (Point3<f64>, (usize, usize));
 
 /// The split point of every edge (visited once, from the triangle where it runs from the lower
-/// vertex index to the higher) that `decide` splits.
+/// vertex index to the higher) that `decide` splits, decided on every core.
 fn choose_splits(
     surface: &Surface,
-    decide: impl Fn(&Surface, usize, usize) -> Option<Split>,
+    decide: impl Fn(&Surface, usize, usize) -> Option<Split> + Sync,
 ) -> HashMap<(u32, u32), Split> {
-    let mut splits = HashMap::new();
-    for t in &surface.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a < b {
-                if let Some(split) = decide(surface, a as usize, b as usize) {
-                    splits.insert((a, b), split);
-                }
-            }
-        }
-    }
-    splits
+    let edges: Vec<(u32, u32)> = surface
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter(|(a, b)| a < b)
+        .collect();
+    edges
+        .par_iter()
+        .filter_map(|&(a, b)| decide(surface, a as usize, b as usize).map(|split| ((a, b), split)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
 }
 
 /// Inserts the split vertices and re-triangulates every triangle with split edges; each edge is

@@ -59,8 +59,28 @@ impl<'a> Leaves<'a> {
         evaluate(&self.expr, signs)
     }
 
+    /// The solid's inside/outside at a model point, as `classify(&signs(p))` but asking each leaf only when
+    /// the Boolean expression still depends on it (a union whose left side holds p needs no right side).
     pub fn inside(&self, p: &Point3<f64>) -> bool {
-        self.classify(&self.signs(p))
+        self.inside_of(&self.expr, p)
+    }
+
+    fn inside_of(&self, expr: &Expr, p: &Point3<f64>) -> bool {
+        match expr {
+            Expr::Leaf(i) => self.leaves[*i].is_inside(p),
+            Expr::Op(op, _, left, right) => match op {
+                Boolean::Union => self.inside_of(left, p) || self.inside_of(right, p),
+                Boolean::Intersection => self.inside_of(left, p) && self.inside_of(right, p),
+                Boolean::Difference => self.inside_of(left, p) && !self.inside_of(right, p),
+            },
+        }
+    }
+
+    /// Whether the bounds of the tree's value at `p` ([`Self::value_bounds`]) prove |F(p)| < epsilon, with half
+    /// of epsilon left for the rounding of the tree's own evaluation.
+    pub fn proves_on_surface(&self, p: &Point3<f64>, epsilon: f64) -> bool {
+        self.value_bounds(p)
+            .is_some_and(|(lo, hi)| lo > -0.5 * epsilon && hi < 0.5 * epsilon)
     }
 
     /// Bounds of the whole tree's implicit function at a model point, from the leaves whose boxes hold it (their

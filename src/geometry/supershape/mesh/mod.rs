@@ -112,17 +112,12 @@ pub fn polygonise(solid: &Solid, params: &MeshParams) -> Result<TriMesh, MeshErr
     let mut surface = tetra::march(&leaves, &grid, &cells, epsilon)?;
     crease::sharpen(&leaves, solid, &mut surface, epsilon, delta);
     // Every vertex on the whole tree, on every core; the first one off the surface is reported. Its value is
-    // bounded from the primitives near it (`Leaves::value_bounds`), within half of epsilon (the other half for the
-    // tree's own rounding); only a vertex whose bounds do not prove it is evaluated on the whole tree.
-    let proved = |v: &Point3<f64>| {
-        leaves
-            .value_bounds(v)
-            .is_some_and(|(lo, hi)| lo > -0.5 * epsilon && hi < 0.5 * epsilon)
-    };
+    // bounded from the primitives near it (`Leaves::proves_on_surface`); only a vertex whose bounds do not prove
+    // it is evaluated on the whole tree.
     let off_surface = surface
         .vertices
         .par_iter()
-        .filter(|v| !proved(v))
+        .filter(|v| !leaves.proves_on_surface(v, epsilon))
         .map(|v| (*v, solid.value(v)))
         .find_first(|(_, value)| value.is_nan() || value.abs() >= epsilon);
     if let Some((at, value)) = off_surface {

@@ -75,21 +75,43 @@ pub(super) fn march(
             continue;
         }
         for tet in TETRAHEDRA {
-            let (ins, outs): (Vec<usize>, Vec<usize>) = tet.iter().partition(|&&c| inside[c]);
-            if ins.is_empty() || outs.is_empty() {
+            // Fixed arrays, not vectors: this runs for every tetrahedron of every crossed cell.
+            let (mut ins, mut outs) = ([0; 4], [0; 4]);
+            let (mut n_in, mut n_out) = (0, 0);
+            for c in tet {
+                if inside[c] {
+                    ins[n_in] = c;
+                    n_in += 1;
+                } else {
+                    outs[n_out] = c;
+                    n_out += 1;
+                }
+            }
+            if n_in == 0 || n_out == 0 {
                 continue;
             }
+            let (ins, outs) = (&ins[..n_in], &outs[..n_out]);
             // The surface's corners in cyclic order: a triangle around a lone corner, or the
             // quadrilateral between two inside and two outside corners.
-            let edges: Vec<(usize, usize)> = match (ins.len(), outs.len()) {
-                (1, _) => outs.iter().map(|&o| (ins[0], o)).collect(),
-                (_, 1) => ins.iter().map(|&i| (i, outs[0])).collect(),
-                _ => vec![
-                    (ins[0], outs[0]),
-                    (ins[0], outs[1]),
-                    (ins[1], outs[1]),
-                    (ins[1], outs[0]),
-                ],
+            let (quad, triangle);
+            let edges: &[(usize, usize)] = match (n_in, n_out) {
+                (1, _) => {
+                    triangle = [(ins[0], outs[0]), (ins[0], outs[1]), (ins[0], outs[2])];
+                    &triangle
+                }
+                (_, 1) => {
+                    triangle = [(ins[0], outs[0]), (ins[1], outs[0]), (ins[2], outs[0])];
+                    &triangle
+                }
+                _ => {
+                    quad = [
+                        (ins[0], outs[0]),
+                        (ins[0], outs[1]),
+                        (ins[1], outs[1]),
+                        (ins[1], outs[0]),
+                    ];
+                    &quad
+                }
             };
             // Orientation from the edges' midpoints in grid units (never degenerate, unlike the
             // roots, which may crowd at a corner): normals point from inside to outside.
