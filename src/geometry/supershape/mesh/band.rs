@@ -29,6 +29,15 @@ impl Grid {
         Self { origin, cell, dims }
     }
 
+    pub fn vertex_count(&self) -> u64 {
+        self.dims.iter().product()
+    }
+
+    pub fn vertex_ijk(&self, id: u64) -> [u64; 3] {
+        let [nx, ny, _] = self.dims;
+        [id % nx, (id / nx) % ny, id / (nx * ny)]
+    }
+
     pub fn vertex_id(&self, ijk: [u64; 3]) -> u64 {
         ijk[0] + self.dims[0] * (ijk[1] + self.dims[1] * ijk[2])
     }
@@ -80,8 +89,9 @@ impl Grid {
 /// of the shapes a part model uses (symmetry numbers up to 12 around theta).
 const BASE_SUPERSHAPE: (usize, usize) = (48, 24);
 const BASE_FACE: usize = 4;
-/// Depth limit of the patch refinement: 2^14 subdivisions of a base patch.
-const MAX_DEPTH: u32 = 14;
+/// Depth limit of the patch refinement: 2^14 subdivisions of a base patch along each parameter (a split
+/// across one parameter counts as one level).
+const MAX_DEPTH: u32 = 28;
 
 /// Every cell within one cell of a parametric sample of a primitive's surface, in the order of their lowest
 /// vertices' ids (z, then y, then x). Patches are split until their corners are closer than half a cell, so
@@ -99,14 +109,14 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
     let sampled = patches
         .par_iter()
         .fold(
-            || Cells::new(cell_count),
+            || Bits::new(cell_count),
             |mut cells, (i, patch)| {
                 sample_base_patch(&leaves.leaves[*i], patch, grid, &mut cells);
                 cells
             },
         )
-        .reduce(|| Cells::new(cell_count), Cells::union);
-    let mut band = Cells::new(cell_count);
+        .reduce(|| Bits::new(cell_count), Bits::union);
+    let mut band = Bits::new(cell_count);
     for c in sampled.iter().map(|id| grid.cell_ijk(id)) {
         for dz in -1..=1 {
             for dy in -1..=1 {
@@ -122,16 +132,21 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
     band.iter().map(|id| grid.cell_ijk(id)).collect()
 }
 
-/// A set of the grid's cells as bits, by cell id: one bit a cell where a hash set spent tens of bytes and a hash.
-struct Cells(Vec<u64>);
+/// A set of the grid's cells or vertices as bits, by id: one bit each where a hash set spent tens of bytes and
+/// a hash, and its ids come out in order without a sort.
+pub(super) struct Bits(Vec<u64>);
 
-impl Cells {
-    fn new(count: u64) -> Self {
+impl Bits {
+    pub fn new(count: u64) -> Self {
         Self(vec![0; count.div_ceil(64) as usize])
     }
 
-    fn insert(&mut self, id: u64) {
+    pub fn insert(&mut self, id: u64) {
         self.0[(id / 64) as usize] |= 1 << (id % 64);
+    }
+
+    pub fn contains(&self, id: u64) -> bool {
+        self.0[(id / 64) as usize] & (1 << (id % 64)) != 0
     }
 
     fn union(mut self, other: Self) -> Self {
@@ -140,7 +155,7 @@ impl Cells {
     }
 
     /// The ids in increasing order.
-    fn iter(&self) -> impl Iterator<Item = u64> + '_ {
+    pub fn iter(&self) -> impl Iterator<Item = u64> + '_ {
         self.0.iter().enumerate().flat_map(|(word, &bits)| {
             (0..64)
                 .filter(move |bit| bits & (1 << bit) != 0)
@@ -194,7 +209,7 @@ fn base_patches(leaf: &Leaf) -> Vec<BasePatch> {
 }
 
 /// Marks the cells holding a parametric sample of one base patch of a primitive's surface within its clip box.
-fn sample_base_patch(leaf: &Leaf, patch: &BasePatch, grid: &Grid, cells: &mut Cells) {
+fn sample_base_patch(leaf: &Leaf, patch: &BasePatch, grid: &Grid, cells: &mut Bits) {
     let clip = leaf.clip;
     let mut mark = |p: &Point3<f64>| {
         if clip.contains(p) {
@@ -243,8 +258,10 @@ fn sample_patch(
 }
 
 /// One patch with its corners (in the order (u0, v0), (u1, v0), (u1, v1), (u0, v1)) already on the
-/// surface: marked, or split in four at its middle lines, the corners shared with the children so
-/// that each split costs five new surface points, not sixteen.
+/// surface: marked, or split at its middle lines, the corners shared with the children. A patch much longer
+/// along one parameter than the other (a cylinder's wall patch is 8 mm round and under 1 mm high) is split
+/// across that parameter only: split in four, its short side would be cut as often as its long one and sampled
+/// many times more finely than the cell needs.
 fn split_patch(
     surface: &impl Fn(f64, f64) -> Point3<f64>,
     [u0, u1, v0, v1]: [f64; 4],
@@ -262,6 +279,28 @@ fn split_patch(
     }
     let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
     let [c00, c10, c11, c01] = *corners;
+    let along_u = (c10 - c00).norm().max((c11 - c01).norm());
+    let along_v = (c01 - c00).norm().max((c11 - c10).norm());
+    if along_u > 2.0 * along_v {
+        let (bottom, top) = (surface(um, v0), surface(um, v1));
+        for (rect, corners) in [
+            ([u0, um, v0, v1], [c00, bottom, top, c01]),
+            ([um, u1, v0, v1], [bottom, c10, c11, top]),
+        ] {
+            split_patch(surface, rect, &corners, cell, depth + 1, mark);
+        }
+        return;
+    }
+    if along_v > 2.0 * along_u {
+        let (left, right) = (surface(u0, vm), surface(u1, vm));
+        for (rect, corners) in [
+            ([u0, u1, v0, vm], [c00, c10, right, left]),
+            ([u0, u1, vm, v1], [left, right, c11, c01]),
+        ] {
+            split_patch(surface, rect, &corners, cell, depth + 1, mark);
+        }
+        return;
+    }
     let (bottom, right, top, left, middle) = (
         surface(um, v0),
         surface(u1, vm),

@@ -14,7 +14,7 @@ use foldhash::{HashMap, HashMapExt};
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
-use super::band::Grid;
+use super::band::{Bits, Grid};
 use super::leaves::Leaves;
 use super::MeshError;
 
@@ -53,16 +53,22 @@ pub(super) fn march(
     let corners_of = |cell: &[u64; 3]| -> [[u64; 3]; 8] {
         std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]))
     };
-    let mut grid_vertices: Vec<(u64, [u64; 3])> = cells
-        .iter()
-        .flat_map(|cell| corners_of(cell).map(|ijk| (grid.vertex_id(ijk), ijk)))
-        .collect();
-    grid_vertices.sort_unstable_by_key(|(id, _)| *id);
-    grid_vertices.dedup_by_key(|(id, _)| *id);
-    let signs: HashMap<u64, bool> = grid_vertices
+    // The cells' corners as bits over the grid's vertices (their ids in order, no sort), their signs as bits.
+    let mut corners = Bits::new(grid.vertex_count());
+    for cell in cells {
+        for ijk in corners_of(cell) {
+            corners.insert(grid.vertex_id(ijk));
+        }
+    }
+    let ids: Vec<u64> = corners.iter().collect();
+    let inside_flags: Vec<bool> = ids
         .par_iter()
-        .map(|(id, ijk)| (*id, leaves.inside(&grid.vertex_point(*ijk))))
+        .map(|&id| leaves.inside(&grid.vertex_point(grid.vertex_ijk(id))))
         .collect();
+    let mut signs = Bits::new(grid.vertex_count());
+    for (&id, _) in ids.iter().zip(&inside_flags).filter(|(_, &inside)| inside) {
+        signs.insert(id);
+    }
     let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
     // The grid edges whose roots are wanted, (inside end, outside end), in vertex order.
     let mut crossings: Vec<(Point3<f64>, Point3<f64>)> = Vec::new();
@@ -70,7 +76,7 @@ pub(super) fn march(
     for cell in cells {
         let corners = corners_of(cell);
         let ids = corners.map(|ijk| grid.vertex_id(ijk));
-        let inside: [bool; 8] = std::array::from_fn(|c| signs[&ids[c]]);
+        let inside: [bool; 8] = std::array::from_fn(|c| signs.contains(ids[c]));
         if inside.iter().all(|&s| s == inside[0]) {
             continue;
         }
