@@ -23,7 +23,8 @@ pub(super) struct Leaf<'a> {
 
 enum Expr {
     Leaf(usize),
-    Op(Boolean, RFunction, Box<Expr>, Box<Expr>),
+    /// A Boolean node with its box in the model frame: outside it the node's solid is not, and its value is < 0.
+    Op(Boolean, RFunction, Aabb, Box<Expr>, Box<Expr>),
 }
 
 /// The tree as leaves plus the Boolean expression over their signs.
@@ -68,7 +69,8 @@ impl<'a> Leaves<'a> {
     fn inside_of(&self, expr: &Expr, p: &Point3<f64>) -> bool {
         match expr {
             Expr::Leaf(i) => self.leaves[*i].is_inside(p),
-            Expr::Op(op, _, left, right) => match op {
+            Expr::Op(_, _, bounds, ..) if !bounds.contains(p) => false,
+            Expr::Op(op, _, _, left, right) => match op {
                 Boolean::Union => self.inside_of(left, p) || self.inside_of(right, p),
                 Boolean::Intersection => self.inside_of(left, p) && self.inside_of(right, p),
                 Boolean::Difference => self.inside_of(left, p) && !self.inside_of(right, p),
@@ -84,7 +86,8 @@ impl<'a> Leaves<'a> {
     }
 
     /// Bounds of the whole tree's implicit function at a model point, from the leaves whose boxes hold it (their
-    /// values, exactly as `Solid::value` computes them) and the others known only to be outside, (-inf, 0]: the
+    /// values, exactly as `Solid::value` computes them) and the others (or whole subtrees whose boxes do not hold
+    /// it) known only to be outside, (-inf, 0]: the
     /// R-functions are monotone, so their values at the ends bound the tree (see `RFunction::combine_bounds`).
     /// Most of a part's primitives are far from any one point, and a point on the surface gets bounds as narrow
     /// as its own primitive's value at a small fraction of the tree's cost. `None` under an R-function that is not
@@ -104,7 +107,9 @@ impl<'a> Leaves<'a> {
                     (f64::NEG_INFINITY, 0.0)
                 })
             }
-            Expr::Op(op, rfunction, left, right) => {
+            // The whole subtree outside: known only to be outside, as a leaf would be.
+            Expr::Op(_, _, bounds, ..) if !bounds.contains(p) => Some((f64::NEG_INFINITY, 0.0)),
+            Expr::Op(op, rfunction, _, left, right) => {
                 rfunction.combine_bounds(*op, self.bounds_of(left, p)?, self.bounds_of(right, p)?)
             }
         }
@@ -114,7 +119,7 @@ impl<'a> Leaves<'a> {
 fn evaluate(expr: &Expr, signs: &[bool]) -> bool {
     match expr {
         Expr::Leaf(i) => signs[*i],
-        Expr::Op(op, _, left, right) => {
+        Expr::Op(op, _, _, left, right) => {
             let (l, r) = (evaluate(left, signs), evaluate(right, signs));
             match op {
                 Boolean::Union => l || r,
@@ -148,7 +153,7 @@ fn flatten<'a>(
             let clip = clip.intersection(&own);
             let l = flatten(left, &chain, clip, bounds, index, leaves);
             let r = flatten(right, &chain, clip, bounds, index, leaves);
-            Expr::Op(*op, *rfunction, Box::new(l), Box::new(r))
+            Expr::Op(*op, *rfunction, own, Box::new(l), Box::new(r))
         }
         _ => {
             leaves.push(Leaf {
