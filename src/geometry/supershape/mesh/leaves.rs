@@ -212,27 +212,35 @@ mod tests {
     use super::super::hub::brake_hub;
     use super::*;
 
+    /// One point in each of n[0] x n[1] x n[2] cells of the solid's box, off the cells' centres.
+    fn across_the_box(solid: &Solid, n: [usize; 3]) -> Vec<Point3<f64>> {
+        let b = solid.bounds();
+        let mut points = Vec::new();
+        for i in 0..n[0] {
+            for j in 0..n[1] {
+                for k in 0..n[2] {
+                    let t = Vector3::new(
+                        (i as f64 + 0.3) / n[0] as f64,
+                        (j as f64 + 0.7) / n[1] as f64,
+                        (k as f64 + 0.4) / n[2] as f64,
+                    );
+                    points.push(b.min + (b.max - b.min).component_mul(&t));
+                }
+            }
+        }
+        points
+    }
+
     #[test]
     fn leaf_signs_classify_like_the_solid() {
         let solid = brake_hub();
         let leaves = Leaves::new(&solid);
         assert_eq!(leaves.leaves.len(), solid.root().counts().0);
-        let b = solid.bounds();
         let (mut inside, mut total) = (0, 0);
-        for i in 0..40 {
-            for j in 0..40 {
-                for k in 0..10 {
-                    let t = Vector3::new(
-                        (i as f64 + 0.3) / 40.0,
-                        (j as f64 + 0.7) / 40.0,
-                        (k as f64 + 0.4) / 10.0,
-                    );
-                    let p = b.min + (b.max - b.min).component_mul(&t);
-                    assert_eq!(leaves.inside(&p), solid.contains(&p), "{p}");
-                    inside += usize::from(solid.contains(&p));
-                    total += 1;
-                }
-            }
+        for p in across_the_box(&solid, [40, 40, 10]) {
+            assert_eq!(leaves.inside(&p), solid.contains(&p), "{p}");
+            inside += usize::from(solid.contains(&p));
+            total += 1;
         }
         assert!(
             inside > total / 20 && inside < total / 2,
@@ -244,24 +252,13 @@ mod tests {
     fn the_trees_value_lies_within_its_bounds_from_the_leaves_near_a_point() {
         let solid = brake_hub();
         let leaves = Leaves::new(&solid);
-        let b = solid.bounds();
-        for i in 0..30 {
-            for j in 0..30 {
-                for k in 0..12 {
-                    let t = Vector3::new(
-                        (i as f64 + 0.3) / 30.0,
-                        (j as f64 + 0.7) / 30.0,
-                        (k as f64 + 0.4) / 12.0,
-                    );
-                    let p = b.min + (b.max - b.min).component_mul(&t);
-                    let value = solid.value(&p);
-                    let (lo, hi) = leaves.value_bounds(&p).expect("R_p is monotone");
-                    assert!(
-                        lo <= value + 1e-12 && value <= hi + 1e-12,
-                        "{p}: {value} not in [{lo}, {hi}]"
-                    );
-                }
-            }
+        for p in across_the_box(&solid, [30, 30, 12]) {
+            let value = solid.value(&p);
+            let (lo, hi) = leaves.value_bounds(&p).expect("R_p is monotone");
+            assert!(
+                lo <= value + 1e-12 && value <= hi + 1e-12,
+                "{p}: {value} not in [{lo}, {hi}]"
+            );
         }
         // On the surface the bounds are about as narrow as the value of the primitive the point lies on (at most
         // twice it, where a union's other side is far): at every vertex of the hub's mesh within a tenth of the
