@@ -7,9 +7,10 @@
 
 use std::path::Path;
 use std::process::Command;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use zeroset::geometry::supershape::csg::Solid;
 use zeroset::geometry::supershape::mesh::hub::brake_hub;
 use zeroset::geometry::supershape::mesh::{polygonise, MeshParams};
 
@@ -41,12 +42,13 @@ fn mesh_hub(c: &mut Criterion) {
         });
     }
     group.finish();
-    fidget_peer();
+    fidget_peer(&hub);
 }
 
 /// Builds and runs the Fidget peer at each cell size, printing what it measured (its median of five meshings,
-/// octree and dual walk, JIT compilation included; the largest distance of its vertices off its surface).
-fn fidget_peer() {
+/// octree and dual walk, JIT compilation included; the largest distance of its vertices off its surface), and
+/// our median of five beside it, timed the same way, with the ratio.
+fn fidget_peer(hub: &Solid) {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/peers/fidget_hub");
     let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/fidget_hub");
     let built = Command::new(env!("CARGO"))
@@ -69,7 +71,33 @@ fn fidget_peer() {
         for line in printed.lines().filter(|l| !l.starts_with("fidget: depth")) {
             println!("peer, cell {cell} mm: {line}");
         }
+        let peer_seconds = printed
+            .lines()
+            .find_map(|l| l.strip_prefix("fidget: median of 5: "))
+            .and_then(|rest| rest.trim_end_matches(" s").parse::<f64>().ok());
+        let ours = median_seconds(5, || {
+            polygonise(hub, &MeshParams::with_cell(cell)).expect("the hub meshes");
+        });
+        match peer_seconds {
+            Some(peer) => println!(
+                "cell {cell} mm: zeroset median of 5: {ours:.3} s, Fidget {peer:.3} s: zeroset takes {:.2}x Fidget's time",
+                ours / peer
+            ),
+            None => println!("cell {cell} mm: zeroset median of 5: {ours:.3} s; the peer printed no median"),
+        }
     }
+}
+
+fn median_seconds(runs: usize, mut work: impl FnMut()) -> f64 {
+    let mut seconds: Vec<f64> = (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            work();
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    seconds.sort_by(f64::total_cmp);
+    seconds[runs / 2]
 }
 
 criterion_group!(benches, mesh_hub);
