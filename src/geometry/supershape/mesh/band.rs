@@ -6,6 +6,7 @@
 //! sampled surfaces is classified, not the whole box.
 
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
@@ -34,12 +35,11 @@ impl Grid {
     }
 
     pub fn vertex_ijk(&self, id: u64) -> [u64; 3] {
-        let [nx, ny, _] = self.dims;
-        [id % nx, (id / nx) % ny, id / (nx * ny)]
+        ijk_of(self.dims, id)
     }
 
     pub fn vertex_id(&self, ijk: [u64; 3]) -> u64 {
-        ijk[0] + self.dims[0] * (ijk[1] + self.dims[1] * ijk[2])
+        id_of(self.dims, ijk)
     }
 
     pub fn vertex_point(&self, ijk: [u64; 3]) -> Point3<f64> {
@@ -70,19 +70,30 @@ impl Grid {
 
     /// A cell's id: its place in the order z, then y, then x (that of its lowest vertex's id).
     fn cell_id(&self, ijk: [u64; 3]) -> u64 {
-        let [nx, ny, _] = self.cells_along();
-        ijk[0] + nx * (ijk[1] + ny * ijk[2])
+        id_of(self.cells_along(), ijk)
     }
 
     fn cell_ijk(&self, id: u64) -> [u64; 3] {
-        let [nx, ny, _] = self.cells_along();
-        [id % nx, (id / nx) % ny, id / (nx * ny)]
+        ijk_of(self.cells_along(), id)
     }
 
     /// Whether a cell has all its vertices inside the grid.
     fn has_cell(&self, ijk: [i64; 3]) -> bool {
         (0..3).all(|axis| ijk[axis] >= 0 && (ijk[axis] as u64) + 1 < self.dims[axis])
     }
+}
+
+/// The id of (i, j, k) among `dims` points or cells: x fastest, then y, then z.
+fn id_of(dims: [u64; 3], ijk: [u64; 3]) -> u64 {
+    ijk[0] + dims[0] * (ijk[1] + dims[1] * ijk[2])
+}
+
+fn ijk_of(dims: [u64; 3], id: u64) -> [u64; 3] {
+    [
+        id % dims[0],
+        (id / dims[0]) % dims[1],
+        id / (dims[0] * dims[1]),
+    ]
 }
 
 /// Base parametric grid before refinement: fine enough that a patch cannot fold over a whole lobe
@@ -105,18 +116,11 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
         .enumerate()
         .flat_map(|(i, leaf)| base_patches(leaf).into_iter().map(move |patch| (i, patch)))
         .collect();
-    let cell_count = grid.cell_count();
-    let sampled = patches
+    let sampled = Bits::new(grid.cell_count());
+    patches
         .par_iter()
-        .fold(
-            || Bits::new(cell_count),
-            |mut cells, (i, patch)| {
-                sample_base_patch(&leaves.leaves[*i], patch, grid, &mut cells);
-                cells
-            },
-        )
-        .reduce(|| Bits::new(cell_count), Bits::union);
-    let mut band = Bits::new(cell_count);
+        .for_each(|(i, patch)| sample_base_patch(&leaves.leaves[*i], patch, grid, &sampled));
+    let band = Bits::new(grid.cell_count());
     for c in sampled.iter().map(|id| grid.cell_ijk(id)) {
         for dz in -1..=1 {
             for dy in -1..=1 {
@@ -133,30 +137,27 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
 }
 
 /// A set of the grid's cells or vertices as bits, by id: one bit each where a hash set spent tens of bytes and
-/// a hash, and its ids come out in order without a sort.
-pub(super) struct Bits(Vec<u64>);
+/// a hash, and its ids come out in order without a sort. Atomic, so that every core marks the one set: a set per
+/// task would cost a copy of the whole grid's bits each.
+pub(super) struct Bits(Vec<AtomicU64>);
 
 impl Bits {
     pub fn new(count: u64) -> Self {
-        Self(vec![0; count.div_ceil(64) as usize])
+        Self((0..count.div_ceil(64)).map(|_| AtomicU64::new(0)).collect())
     }
 
-    pub fn insert(&mut self, id: u64) {
-        self.0[(id / 64) as usize] |= 1 << (id % 64);
+    pub fn insert(&self, id: u64) {
+        self.0[(id / 64) as usize].fetch_or(1 << (id % 64), Ordering::Relaxed);
     }
 
     pub fn contains(&self, id: u64) -> bool {
-        self.0[(id / 64) as usize] & (1 << (id % 64)) != 0
-    }
-
-    fn union(mut self, other: Self) -> Self {
-        self.0.iter_mut().zip(&other.0).for_each(|(a, b)| *a |= b);
-        self
+        self.0[(id / 64) as usize].load(Ordering::Relaxed) & (1 << (id % 64)) != 0
     }
 
     /// The ids in increasing order.
     pub fn iter(&self) -> impl Iterator<Item = u64> + '_ {
-        self.0.iter().enumerate().flat_map(|(word, &bits)| {
+        self.0.iter().enumerate().flat_map(|(word, bits)| {
+            let bits = bits.load(Ordering::Relaxed);
             (0..64)
                 .filter(move |bit| bits & (1 << bit) != 0)
                 .map(move |bit| word as u64 * 64 + bit)
@@ -209,7 +210,7 @@ fn base_patches(leaf: &Leaf) -> Vec<BasePatch> {
 }
 
 /// Marks the cells holding a parametric sample of one base patch of a primitive's surface within its clip box.
-fn sample_base_patch(leaf: &Leaf, patch: &BasePatch, grid: &Grid, cells: &mut Bits) {
+fn sample_base_patch(leaf: &Leaf, patch: &BasePatch, grid: &Grid, cells: &Bits) {
     let clip = leaf.clip;
     let mut mark = |p: &Point3<f64>| {
         if clip.contains(p) {
@@ -281,39 +282,41 @@ fn split_patch(
     let [c00, c10, c11, c01] = *corners;
     let along_u = (c10 - c00).norm().max((c11 - c01).norm());
     let along_v = (c01 - c00).norm().max((c11 - c10).norm());
-    if along_u > 2.0 * along_v {
+    let (halves, quarters): ([Child; 2], [Child; 4]);
+    let children: &[Child] = if along_u > 2.0 * along_v {
         let (bottom, top) = (surface(um, v0), surface(um, v1));
-        for (rect, corners) in [
+        halves = [
             ([u0, um, v0, v1], [c00, bottom, top, c01]),
             ([um, u1, v0, v1], [bottom, c10, c11, top]),
-        ] {
-            split_patch(surface, rect, &corners, cell, depth + 1, mark);
-        }
-        return;
-    }
-    if along_v > 2.0 * along_u {
+        ];
+        &halves
+    } else if along_v > 2.0 * along_u {
         let (left, right) = (surface(u0, vm), surface(u1, vm));
-        for (rect, corners) in [
+        halves = [
             ([u0, u1, v0, vm], [c00, c10, right, left]),
             ([u0, u1, vm, v1], [left, right, c11, c01]),
-        ] {
-            split_patch(surface, rect, &corners, cell, depth + 1, mark);
-        }
-        return;
-    }
-    let (bottom, right, top, left, middle) = (
-        surface(um, v0),
-        surface(u1, vm),
-        surface(um, v1),
-        surface(u0, vm),
-        surface(um, vm),
-    );
-    for (rect, corners) in [
-        ([u0, um, v0, vm], [c00, bottom, middle, left]),
-        ([um, u1, v0, vm], [bottom, c10, right, middle]),
-        ([um, u1, vm, v1], [middle, right, c11, top]),
-        ([u0, um, vm, v1], [left, middle, top, c01]),
-    ] {
-        split_patch(surface, rect, &corners, cell, depth + 1, mark);
+        ];
+        &halves
+    } else {
+        let (bottom, right, top, left, middle) = (
+            surface(um, v0),
+            surface(u1, vm),
+            surface(um, v1),
+            surface(u0, vm),
+            surface(um, vm),
+        );
+        quarters = [
+            ([u0, um, v0, vm], [c00, bottom, middle, left]),
+            ([um, u1, v0, vm], [bottom, c10, right, middle]),
+            ([um, u1, vm, v1], [middle, right, c11, top]),
+            ([u0, um, vm, v1], [left, middle, top, c01]),
+        ];
+        &quarters
+    };
+    for (rect, corners) in children {
+        split_patch(surface, *rect, corners, cell, depth + 1, mark);
     }
 }
+
+/// A sub-patch: its parameter rectangle and its corners on the surface.
+type Child = ([f64; 4], [Point3<f64>; 4]);

@@ -54,7 +54,7 @@ pub(super) fn march(
         std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]))
     };
     // The cells' corners as bits over the grid's vertices (their ids in order, no sort), their signs as bits.
-    let mut corners = Bits::new(grid.vertex_count());
+    let corners = Bits::new(grid.vertex_count());
     for cell in cells {
         for ijk in corners_of(cell) {
             corners.insert(grid.vertex_id(ijk));
@@ -65,7 +65,7 @@ pub(super) fn march(
         .par_iter()
         .map(|&id| leaves.inside(&grid.vertex_point(grid.vertex_ijk(id))))
         .collect();
-    let mut signs = Bits::new(grid.vertex_count());
+    let signs = Bits::new(grid.vertex_count());
     for (&id, _) in ids.iter().zip(&inside_flags).filter(|(_, &inside)| inside) {
         signs.insert(id);
     }
