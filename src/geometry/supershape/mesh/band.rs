@@ -105,10 +105,14 @@ const BASE_FACE: usize = 4;
 const MAX_DEPTH: u32 = 28;
 
 /// Every cell within one cell of a parametric sample of a primitive's surface, in the order of their lowest
-/// vertices' ids (z, then y, then x). Patches are split until their corners are closer than half a cell, so
-/// every surface point lies within half a cell of a sample, and every cell the surface crosses is a neighbour
-/// of a sampled cell. The base patches of every primitive are sampled on every core (one large primitive, the
-/// rim of a hub, would otherwise keep one core busy alone); the cells are marked in bit sets over the grid.
+/// vertices' ids (z, then y, then x). Patches are split until their diagonals are at most a cell long: a point
+/// of a flat patch then lies within half a cell of one of its corners, and of a patch folded at a right angle
+/// (a box's edge, a near-square profile's rim) within 0.71 of a cell. A point less than a cell from a sample
+/// lies in a cell at most one step from the sample's along each axis, a neighbour: every cell the surface
+/// crosses is in the band. (Splitting down to half a cell sampled four times as many points for the same band
+/// on the brake hub at 1 and 0.5 mm.) The base patches of every primitive are sampled on every core (one large
+/// primitive, the rim of a hub, would otherwise keep one core busy alone); the cells are marked in bit sets over
+/// the grid.
 pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
     let patches: Vec<(usize, BasePatch)> = leaves
         .leaves
@@ -241,8 +245,8 @@ fn face_point(leaf: &Leaf, half: &[f64; 3], axis: usize, side: f64, u: f64, v: f
     leaf.to_model(&Point3::from(c))
 }
 
-/// Samples the patch [u0, u1] x [v0, v1] of a parametric surface, splitting it in four while its
-/// corners are more than half a cell apart.
+/// Samples the patch [u0, u1] x [v0, v1] of a parametric surface, splitting it while its diagonals are longer
+/// than a cell.
 fn sample_patch(
     surface: &impl Fn(f64, f64) -> Point3<f64>,
     [u0, u1, v0, v1]: [f64; 4],
@@ -274,7 +278,7 @@ fn split_patch(
     let spread = (corners[0] - corners[2])
         .norm()
         .max((corners[1] - corners[3]).norm());
-    if spread <= 0.5 * cell || depth == MAX_DEPTH {
+    if spread <= cell || depth == MAX_DEPTH {
         corners.iter().for_each(&mut *mark);
         return;
     }
