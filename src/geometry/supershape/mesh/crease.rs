@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::super::csg::Solid;
 use super::leaves::Leaves;
+use super::regula_falsi;
 use super::tetra::Surface;
 
 const MAX_NEWTON_STEPS: u32 = 30;
@@ -34,7 +35,7 @@ pub(super) fn sharpen(
             return None;
         }
         let (pa, pb) = (surface.vertices[a], surface.vertices[b]);
-        let start = balance_point(leaves, i, j, pa, pb);
+        let start = balance_point(leaves, i, j, pa, pb, epsilon);
         let point = curve_point(leaves, i, j, start, epsilon)?;
         acceptable(leaves, solid, epsilon, &point, &start, (pb - pa).norm())
             .then_some((point, (i, j)))
@@ -151,26 +152,23 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
     surface.triangles = triangles;
 }
 
-/// The point of segment [a, b] (a on primitive i, b on j) where |f_i| = |f_j|, by bisection:
-/// |f_i| - |f_j| is <= 0 at a and >= 0 at b. A start for the curve search near the segment.
+/// The point of segment [a, b] (a on primitive i, b on j) where |f_i| = |f_j| (|f_i| - |f_j| is <= 0 at a and
+/// >= 0 at b), by regula falsi: a start for the curve search near the segment. Its midpoint if the gap does not
+/// change sign along it.
 fn balance_point(
     leaves: &Leaves,
     i: usize,
     j: usize,
     a: Point3<f64>,
     b: Point3<f64>,
+    epsilon: f64,
 ) -> Point3<f64> {
-    let gap = |p: &Point3<f64>| leaves.leaves[i].value(p).abs() - leaves.leaves[j].value(p).abs();
-    let (mut lo, mut hi) = (a, b);
-    for _ in 0..40 {
-        let m = nalgebra::center(&lo, &hi);
-        if gap(&m) <= 0.0 {
-            lo = m;
-        } else {
-            hi = m;
-        }
-    }
-    nalgebra::center(&lo, &hi)
+    let at = |t: f64| a + (b - a) * t;
+    let gap = |t: f64| {
+        let p = at(t);
+        leaves.leaves[i].value(&p).abs() - leaves.leaves[j].value(&p).abs()
+    };
+    at(regula_falsi::root(gap, (gap(0.0), gap(1.0)), 1e-3 * epsilon).unwrap_or(0.5))
 }
 
 /// A point of the intersection curve of primitives i and j near `start`: Gauss-Newton on

@@ -31,6 +31,7 @@ mod crease;
 mod export;
 pub mod hub;
 mod leaves;
+mod regula_falsi;
 mod tetra;
 mod trimesh;
 

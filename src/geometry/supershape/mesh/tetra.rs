@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 use super::band::{Bits, Grid};
 use super::leaves::Leaves;
+use super::regula_falsi;
 use super::MeshError;
 
 /// A triangulated surface with, for each vertex, the primitives whose surfaces hold it (the
@@ -180,12 +181,11 @@ fn push_polygon(surface: &mut Surface, ids: &[u32]) {
 
 /// Halvings of a grid edge while more than one primitive changes sign along it.
 const MAX_HALVINGS: u32 = 60;
-const MAX_SECANT_STEPS: u32 = 100;
 
 /// The point where the solid's sign flips between `inside` (in) and `outside`, with the primitive
 /// whose surface holds it. While several primitives change sign along the segment it is halved,
 /// keeping the half where the solid's sign flips; then the one primitive left is solved on the
-/// segment by regula falsi (Illinois variant) until |f| is far below epsilon.
+/// segment by regula falsi (`regula_falsi`) until |f| is far below epsilon.
 fn edge_root(
     leaves: &Leaves,
     inside: Point3<f64>,
@@ -227,7 +227,7 @@ fn edge_root(
     Ok((m, leaf))
 }
 
-/// Regula falsi on one primitive's function along [a, b], where it changes sign.
+/// The root of one primitive's function along [a, b], where it changes sign.
 fn solve_on_segment(
     leaves: &Leaves,
     leaf: usize,
@@ -235,37 +235,9 @@ fn solve_on_segment(
     b: Point3<f64>,
     epsilon: f64,
 ) -> Result<Point3<f64>, MeshError> {
-    let f = |t: f64| leaves.leaves[leaf].value(&(a + (b - a) * t));
-    let (mut t0, mut t1) = (0.0, 1.0);
-    let (mut f0, mut f1) = (f(t0), f(t1));
-    if f0 * f1 > 0.0 {
-        return Err(MeshError::NoRoot { near: a });
-    }
-    let tolerance = 1e-3 * epsilon;
-    let mut side = 0;
-    for _ in 0..MAX_SECANT_STEPS {
-        let t = if f0 == f1 {
-            0.5 * (t0 + t1)
-        } else {
-            (t0 * f1 - t1 * f0) / (f1 - f0)
-        };
-        let ft = f(t);
-        if ft.abs() < tolerance || t1 - t0 < 1e-15 {
-            return Ok(a + (b - a) * t);
-        }
-        if (ft > 0.0) == (f0 > 0.0) {
-            (t0, f0) = (t, ft);
-            if side == -1 {
-                f1 *= 0.5;
-            }
-            side = -1;
-        } else {
-            (t1, f1) = (t, ft);
-            if side == 1 {
-                f0 *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    Err(MeshError::NoRoot { near: a })
+    let at = |t: f64| a + (b - a) * t;
+    let f = |t: f64| leaves.leaves[leaf].value(&at(t));
+    regula_falsi::root(f, (f(0.0), f(1.0)), 1e-3 * epsilon)
+        .map(at)
+        .ok_or(MeshError::NoRoot { near: a })
 }
