@@ -111,8 +111,12 @@ impl Superformula {
 
     /// r of eq. 4 from cos and sin of m theta / 4.
     pub(crate) fn radius_at(&self, cos: f64, sin: f64) -> f64 {
-        let sum = abs_pow(cos / self.a, self.n2) + abs_pow(sin / self.b, self.n3);
-        inverse_root(sum, self.n1)
+        let (u, v) = (cos / self.a, sin / self.b);
+        let n = self.n1;
+        if n > 2.0 && self.n2 == n && self.n3 == n {
+            return equal_exponents_radius(u.abs(), v.abs(), n);
+        }
+        inverse_root(abs_pow(u, self.n2) + abs_pow(v, self.n3), n)
     }
 
     /// r of eq. 4 and dr/dtheta from cos and sin of m theta / 4.
@@ -143,6 +147,24 @@ fn abs_pow(x: f64, n: f64) -> f64 {
     } else {
         x.powf(n)
     }
+}
+
+/// (u^n + v^n)^(-1/n) for u, v >= 0 and n > 2, the profile of a part's cylinders and prisms (n = 40: near-square
+/// edges). Written as (1 / big) (1 + t)^(-1/n) with t = (small / big)^n <= 1: over most of the turn t is below
+/// 1e-8, where 1 - t/n is (1 + t)^(-1/n) to within t^2 (its next term's coefficient (1/n)(1/n + 1)/2 is below 1),
+/// under an ulp, and no powf is needed; it takes one power of the ratio where the sum took two.
+fn equal_exponents_radius(u: f64, v: f64, n: f64) -> f64 {
+    let (big, small) = if u >= v { (u, v) } else { (v, u) };
+    if big == 0.0 {
+        return f64::INFINITY;
+    }
+    let t = abs_pow(small / big, n);
+    let root = if t < 1e-8 {
+        1.0 - t / n
+    } else {
+        (1.0 + t).powf(-1.0 / n)
+    };
+    root / big
 }
 
 /// sum^(-1/n1), with the common n1 = 2 (a circle's) and 1 by a square root and a division.
@@ -194,6 +216,31 @@ mod tests {
 
     fn formula(m: f64, n1: f64, n2: f64, n3: f64) -> Superformula {
         Superformula::new(m, n1, n2, n3, 1.0, 1.0).unwrap()
+    }
+
+    #[test]
+    fn equal_exponents_give_the_printed_power_to_rounding_either_side_of_the_series_switch() {
+        for n in [2.5, 3.0, 7.5, 40.0, 100.0] {
+            // Ratios spread over [0, 1], and around the one where (small / big)^n crosses 1e-8.
+            let switch = 1e-8f64.powf(1.0 / n);
+            let ratios = (0..=200)
+                .map(|k| k as f64 / 200.0)
+                .chain((-50..=50).map(|k| switch * (1.0 + k as f64 * 1e-3)));
+            for ratio in ratios {
+                for big in [0.3, 1.0, 1.7] {
+                    let (u, v) = (big, ratio * big);
+                    let printed = (u.powf(n) + v.powf(n)).powf(-1.0 / n);
+                    for (a, b) in [(u, v), (v, u)] {
+                        let got = equal_exponents_radius(a, b, n);
+                        assert!(
+                            (got - printed).abs() <= 4.0 * f64::EPSILON * printed,
+                            "n {n}, u {a}, v {b}: {got} vs {printed}"
+                        );
+                    }
+                }
+            }
+        }
+        assert_eq!(equal_exponents_radius(0.0, 0.0, 40.0), f64::INFINITY);
     }
 
     fn angles(count: usize) -> impl Iterator<Item = f64> {

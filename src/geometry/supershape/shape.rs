@@ -284,6 +284,13 @@ mod tests {
             r2: Superformula::circle(),
             scale: [3.0; 3],
         });
+        // Equal fractional exponents above 2 (the equal-exponent path, with powf where the ratio's power is not
+        // negligible), with m != 4.
+        all.push(Supershape {
+            r1: formula(6.0, 3.5, 3.5, 3.5),
+            r2: formula(4.0, 2.5, 2.5, 2.5),
+            scale: [5.0, 4.0, 3.0],
+        });
         for shape in &all {
             for k in 0..500 {
                 let t = k as f64;
