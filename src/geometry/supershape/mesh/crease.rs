@@ -115,6 +115,8 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
         let (point, (i, j)) = splits[&key];
         surface.vertices.push(point);
         surface.on.push((i.min(j), i.max(j)));
+        // Kept only where it vanishes (`acceptable`).
+        surface.checked.push(true);
         inserted.insert(key, (surface.vertices.len() - 1) as u32);
     }
     let split_of = |a: u32, b: u32| inserted.get(&(a.min(b), a.max(b))).copied();
@@ -152,9 +154,9 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
     surface.triangles = triangles;
 }
 
-/// The point of segment [a, b] (a on primitive i, b on j) where |f_i| = |f_j| (|f_i| - |f_j| is <= 0 at a and
-/// >= 0 at b), by regula falsi: a start for the curve search near the segment. Its midpoint if the gap does not
-/// change sign along it.
+/// The point of segment [a, b] (a on primitive i, b on j) where |f_i| = |f_j| (the gap |f_i| - |f_j| is at most 0
+/// at a and at least 0 at b), by regula falsi: a start for the curve search near the segment. Its midpoint if the
+/// gap does not change sign along it.
 fn balance_point(
     leaves: &Leaves,
     i: usize,
@@ -168,7 +170,8 @@ fn balance_point(
         let p = at(t);
         leaves.leaves[i].value(&p).abs() - leaves.leaves[j].value(&p).abs()
     };
-    at(regula_falsi::root(gap, (gap(0.0), gap(1.0)), 1e-3 * epsilon).unwrap_or(0.5))
+    let t = regula_falsi::root(gap, (gap(0.0), gap(1.0)), 1e-3 * epsilon).map_or(0.5, |(t, _)| t);
+    at(t)
 }
 
 /// A point of the intersection curve of primitives i and j near `start`: Gauss-Newton on

@@ -49,15 +49,27 @@ impl<'a> Leaves<'a> {
         Self { leaves, expr }
     }
 
-    /// Each leaf's inside/outside at a model point; a point outside a leaf's box is outside it.
-    pub fn signs(&self, p: &Point3<f64>) -> Vec<bool> {
-        self.leaves.iter().map(|leaf| leaf.is_inside(p)).collect()
+    /// The values at a model point of the leaves whose boxes hold it, all but `skip`'s; every other leaf is
+    /// outside there.
+    pub fn values_except(&self, p: &Point3<f64>, skip: Option<usize>) -> LeafValues {
+        LeafValues(
+            self.leaves
+                .iter()
+                .enumerate()
+                .filter(|&(i, leaf)| Some(i) != skip && leaf.bounds.contains(p))
+                .map(|(i, leaf)| (i, leaf.value(p)))
+                .collect(),
+        )
+    }
+
+    pub fn values(&self, p: &Point3<f64>) -> LeafValues {
+        self.values_except(p, None)
     }
 
     /// The solid's inside/outside from its leaves' (seed 000: an R-function's sign is the Boolean
     /// function of its arguments' signs).
-    pub fn classify(&self, signs: &[bool]) -> bool {
-        evaluate(&self.expr, signs)
+    pub fn classify(&self, values: &LeafValues) -> bool {
+        evaluate(&self.expr, values)
     }
 
     /// The solid's inside/outside at a model point, as `classify(&signs(p))` but asking each leaf only when
@@ -81,8 +93,19 @@ impl<'a> Leaves<'a> {
     /// Whether the bounds of the tree's value at `p` ([`Self::value_bounds`]) prove |F(p)| < epsilon, with half
     /// of epsilon left for the rounding of the tree's own evaluation.
     pub fn proves_on_surface(&self, p: &Point3<f64>, epsilon: f64) -> bool {
-        self.value_bounds(p)
-            .is_some_and(|(lo, hi)| lo > -0.5 * epsilon && hi < 0.5 * epsilon)
+        proves(self.value_bounds(p), epsilon)
+    }
+
+    /// As [`Self::proves_on_surface`], with the leaves' values at `p` already taken (those of every leaf whose box
+    /// holds it).
+    pub fn values_prove_on_surface(
+        &self,
+        p: &Point3<f64>,
+        values: &LeafValues,
+        epsilon: f64,
+    ) -> bool {
+        let value = |i: usize| values.value(i).unwrap_or_else(|| self.leaves[i].value(p));
+        proves(self.bounds_of(&self.expr, p, &value), epsilon)
     }
 
     /// Bounds of the whole tree's implicit function at a model point, from the leaves whose boxes hold it (their
@@ -93,15 +116,21 @@ impl<'a> Leaves<'a> {
     /// as its own primitive's value at a small fraction of the tree's cost. `None` under an R-function that is not
     /// monotone.
     pub fn value_bounds(&self, p: &Point3<f64>) -> Option<(f64, f64)> {
-        self.bounds_of(&self.expr, p)
+        self.bounds_of(&self.expr, p, &|i| self.leaves[i].value(p))
     }
 
-    fn bounds_of(&self, expr: &Expr, p: &Point3<f64>) -> Option<(f64, f64)> {
+    /// The bounds below `expr`, with `value(i)` leaf i's value at `p` where its box holds `p`.
+    fn bounds_of(
+        &self,
+        expr: &Expr,
+        p: &Point3<f64>,
+        value: &dyn Fn(usize) -> f64,
+    ) -> Option<(f64, f64)> {
         match expr {
             Expr::Leaf(i) => {
                 let leaf = &self.leaves[*i];
                 Some(if leaf.bounds.contains(p) {
-                    let value = leaf.value(p);
+                    let value = value(*i);
                     (value, value)
                 } else {
                     (f64::NEG_INFINITY, 0.0)
@@ -109,18 +138,56 @@ impl<'a> Leaves<'a> {
             }
             // The whole subtree outside: known only to be outside, as a leaf would be.
             Expr::Op(_, _, bounds, ..) if !bounds.contains(p) => Some((f64::NEG_INFINITY, 0.0)),
-            Expr::Op(op, rfunction, _, left, right) => {
-                rfunction.combine_bounds(*op, self.bounds_of(left, p)?, self.bounds_of(right, p)?)
-            }
+            Expr::Op(op, rfunction, _, left, right) => rfunction.combine_bounds(
+                *op,
+                self.bounds_of(left, p, value)?,
+                self.bounds_of(right, p, value)?,
+            ),
         }
     }
 }
 
-fn evaluate(expr: &Expr, signs: &[bool]) -> bool {
+/// |F| < epsilon proved by bounds of F, with half of epsilon left for the rounding of the tree's own evaluation.
+fn proves(bounds: Option<(f64, f64)>, epsilon: f64) -> bool {
+    bounds.is_some_and(|(lo, hi)| lo > -0.5 * epsilon && hi < 0.5 * epsilon)
+}
+
+/// Some leaves' values at one point, in the order of the leaves: those whose boxes hold the point. A leaf not
+/// among them is outside there. A few per point, where a part has tens of leaves: the mesher keeps one per
+/// grid vertex at the ends of the edges the surface crosses.
+#[derive(Clone)]
+pub(super) struct LeafValues(Vec<(usize, f64)>);
+
+impl LeafValues {
+    pub fn value(&self, leaf: usize) -> Option<f64> {
+        self.0.iter().find(|(i, _)| *i == leaf).map(|(_, v)| *v)
+    }
+
+    /// Adds a leaf's value (one not among them).
+    pub fn insert(&mut self, leaf: usize, value: f64) {
+        self.0.push((leaf, value));
+    }
+
+    pub fn is_inside(&self, leaf: usize) -> bool {
+        self.value(leaf).is_some_and(|v| v > 0.0)
+    }
+
+    /// The leaves inside at one point and outside at the other (either may be a leaf whose box holds only
+    /// one of them), in increasing order.
+    pub fn flipped(&self, other: &LeafValues) -> Vec<usize> {
+        let mut leaves: Vec<usize> = self.0.iter().chain(&other.0).map(|(i, _)| *i).collect();
+        leaves.sort_unstable();
+        leaves.dedup();
+        leaves.retain(|&i| self.is_inside(i) != other.is_inside(i));
+        leaves
+    }
+}
+
+fn evaluate(expr: &Expr, values: &LeafValues) -> bool {
     match expr {
-        Expr::Leaf(i) => signs[*i],
+        Expr::Leaf(i) => values.is_inside(*i),
         Expr::Op(op, _, _, left, right) => {
-            let (l, r) = (evaluate(left, signs), evaluate(right, signs));
+            let (l, r) = (evaluate(left, values), evaluate(right, values));
             match op {
                 Boolean::Union => l || r,
                 Boolean::Intersection => l && r,
@@ -274,7 +341,43 @@ mod tests {
                 "{v}: {value} not in [{lo}, {hi}]"
             );
             assert!(lo > -1e-7 && hi < 1e-7, "{v}: [{lo}, {hi}]");
+            // The proof from values already taken is the same proof.
+            let values = leaves.values(v);
+            for epsilon in [1e-6, 1e-15] {
+                assert_eq!(
+                    leaves.values_prove_on_surface(v, &values, epsilon),
+                    leaves.proves_on_surface(v, epsilon)
+                );
+            }
         }
+    }
+
+    #[test]
+    fn leaf_values_give_the_leaves_signs_and_which_flip_between_two_points() {
+        let solid = brake_hub();
+        let leaves = Leaves::new(&solid);
+        let points = across_the_box(&solid, [12, 12, 6]);
+        let mut flips = 0;
+        for pair in points.windows(2) {
+            let (va, vb) = (leaves.values(&pair[0]), leaves.values(&pair[1]));
+            let inside = |p: &Point3<f64>, i: usize| {
+                leaves.leaves[i].bounds.contains(p) && leaves.leaves[i].value(p) > 0.0
+            };
+            let expected: Vec<usize> = (0..leaves.leaves.len())
+                .filter(|&i| inside(&pair[0], i) != inside(&pair[1], i))
+                .collect();
+            assert_eq!(va.flipped(&vb), expected);
+            flips += expected.len();
+            assert_eq!(leaves.classify(&va), solid.contains(&pair[0]));
+            // Leaving one leaf out leaves its value unknown, and only its.
+            let skip = leaves.leaves.len() / 2;
+            let without = leaves.values_except(&pair[0], Some(skip));
+            assert_eq!(without.value(skip), None);
+            for i in (0..leaves.leaves.len()).filter(|&i| i != skip) {
+                assert_eq!(without.value(i), va.value(i));
+            }
+        }
+        assert!(flips > 20, "{flips} leaves flip between neighbours");
     }
 
     #[test]

@@ -112,13 +112,16 @@ pub fn polygonise(solid: &Solid, params: &MeshParams) -> Result<TriMesh, MeshErr
     let cells = band::band(&leaves, &grid);
     let mut surface = tetra::march(&leaves, &grid, &cells, epsilon)?;
     crease::sharpen(&leaves, solid, &mut surface, epsilon, delta);
-    // Every vertex on the whole tree, on every core; the first one off the surface is reported. Its value is
-    // bounded from the primitives near it (`Leaves::proves_on_surface`); only a vertex whose bounds do not prove
-    // it is evaluated on the whole tree.
+    // Every vertex on the whole tree, on every core; the first one off the surface is reported. Most were proved
+    // where they were made, from the leaves' values there; the others' values are bounded from the primitives
+    // near them (`Leaves::proves_on_surface`), and only a vertex whose bounds do not prove it is evaluated on the
+    // whole tree.
     let off_surface = surface
         .vertices
         .par_iter()
-        .filter(|v| !leaves.proves_on_surface(v, epsilon))
+        .zip(&surface.checked)
+        .filter(|(v, checked)| !**checked && !leaves.proves_on_surface(v, epsilon))
+        .map(|(v, _)| v)
         .map(|v| (*v, solid.value(v)))
         .find_first(|(_, value)| value.is_nan() || value.abs() >= epsilon);
     if let Some((at, value)) = off_surface {
@@ -276,6 +279,31 @@ mod tests {
             "{errors:?}"
         );
         assert!(errors[2] < 2e-3, "{errors:?}");
+    }
+
+    #[test]
+    fn a_mesh_whose_vertices_miss_epsilon_is_refused_naming_one() {
+        // No evaluation of F resolves 1e-20 (its rounding alone is about 1e-16): the roots' own proofs fail, and
+        // the final check must find a vertex off the surface rather than pass the mesh.
+        let solid = Solid::new(Node::supershape(
+            Supershape {
+                scale: [10.0, 7.0, 5.0],
+                ..Supershape::sphere()
+            },
+            Deformations::default(),
+        ));
+        let params = MeshParams {
+            epsilon: 1e-20,
+            ..MeshParams::with_cell(2.0)
+        };
+        match polygonise(&solid, &params) {
+            Err(MeshError::OffSurface { at, value, epsilon }) => {
+                assert_eq!(epsilon, 1e-20);
+                assert!(value.abs() >= epsilon, "{value}");
+                assert_eq!(solid.value(&at), value);
+            }
+            other => panic!("{:?}", other.map(|mesh| mesh.vertices.len())),
+        }
     }
 
     #[test]

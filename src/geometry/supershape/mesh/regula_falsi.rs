@@ -5,18 +5,18 @@
 
 const MAX_STEPS: u32 = 100;
 
-/// A t in [0, 1] with |f(t)| < `tolerance` (or the bracket closed to rounding), given f's values at the ends,
-/// of opposite signs (or one of them 0). None if they have the same sign or it does not converge.
-pub(super) fn root(f: impl Fn(f64) -> f64, ends: (f64, f64), tolerance: f64) -> Option<f64> {
+/// A t in [0, 1] with |f(t)| < `tolerance` (or the bracket closed to rounding), and f(t), given f's values at the
+/// ends, of opposite signs (or one of them 0). None if they have the same sign or it does not converge.
+pub(super) fn root(f: impl Fn(f64) -> f64, ends: (f64, f64), tolerance: f64) -> Option<(f64, f64)> {
     let ((mut t0, mut f0), (mut t1, mut f1)) = ((0.0, ends.0), (1.0, ends.1));
     if f0 * f1 > 0.0 || f0.is_nan() || f1.is_nan() {
         return None;
     }
     if f0.abs() < tolerance {
-        return Some(t0);
+        return Some((t0, f0));
     }
     if f1.abs() < tolerance {
-        return Some(t1);
+        return Some((t1, f1));
     }
     // Which end moved last: -1 the low one, 1 the high one.
     let mut side = 0;
@@ -28,7 +28,7 @@ pub(super) fn root(f: impl Fn(f64) -> f64, ends: (f64, f64), tolerance: f64) -> 
         };
         let ft = f(t);
         if ft.abs() < tolerance || t1 - t0 < 1e-15 {
-            return Some(t);
+            return Some((t, ft));
         }
         if (ft > 0.0) == (f0 > 0.0) {
             (t0, f0) = (t, ft);
@@ -59,19 +59,20 @@ mod tests {
             calls.set(calls.get() + 1);
             (t - 0.3) * (1.0 + t * t)
         };
-        let t = root(smooth, (smooth(0.0), smooth(1.0)), 1e-12).unwrap();
+        let (t, value) = root(smooth, (smooth(0.0), smooth(1.0)), 1e-12).unwrap();
         assert!((t - 0.3).abs() < 1e-11, "{t}");
+        assert_eq!(value, smooth(t));
         assert!(calls.get() < 12, "{} evaluations", calls.get());
         let kinked = |t: f64| (t - 0.7).abs().max(0.05) * (t - 0.65).signum();
-        let t = root(kinked, (kinked(0.0), kinked(1.0)), 1e-12).unwrap();
+        let (t, _) = root(kinked, (kinked(0.0), kinked(1.0)), 1e-12).unwrap();
         assert!((t - 0.65).abs() < 1e-12, "{t}");
     }
 
     #[test]
     fn ends_of_one_sign_have_no_root_and_a_zero_end_is_one() {
         assert_eq!(root(|t| t + 1.0, (1.0, 2.0), 1e-9), None);
-        assert_eq!(root(|t| t, (0.0, 1.0), 1e-9), Some(0.0));
-        assert_eq!(root(|t| t - 1.0, (-1.0, 0.0), 1e-9), Some(1.0));
+        assert_eq!(root(|t| t, (0.0, 1.0), 1e-9), Some((0.0, 0.0)));
+        assert_eq!(root(|t| t - 1.0, (-1.0, 0.0), 1e-9), Some((1.0, 0.0)));
         assert_eq!(root(|t| t, (f64::NAN, 1.0), 1e-9), None);
     }
 }

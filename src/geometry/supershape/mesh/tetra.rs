@@ -9,13 +9,15 @@
 //! primitive's own function (the tree's value is a product of R-function partials times it, and
 //! cheaper to get exactly): the vertex remembers its primitive for the sharp-edge step.
 
+use std::borrow::Cow;
+
 use foldhash::{HashMap, HashMapExt};
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::band::{Bits, Grid};
-use super::leaves::Leaves;
+use super::leaves::{LeafValues, Leaves};
 use super::regula_falsi;
 use super::MeshError;
 
@@ -24,6 +26,9 @@ use super::MeshError;
 pub(super) struct Surface {
     pub vertices: Vec<Point3<f64>>,
     pub on: Vec<(usize, usize)>,
+    /// Whether |F| < epsilon was already proved for the vertex where it was made (from the leaves' values that
+    /// its own step took there); the mesh's final check evaluates the others.
+    pub checked: Vec<bool>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -71,8 +76,8 @@ pub(super) fn march(
         signs.insert(id);
     }
     let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
-    // The grid edges whose roots are wanted, (inside end, outside end), in vertex order.
-    let mut crossings: Vec<(Point3<f64>, Point3<f64>)> = Vec::new();
+    // The grid edges whose roots are wanted, (inside end, outside end) by vertex id, in vertex order.
+    let mut crossings: Vec<(u64, u64)> = Vec::new();
     let mut loops: Vec<Vec<u32>> = Vec::new();
     for cell in cells {
         let corners = corners_of(cell);
@@ -132,8 +137,7 @@ pub(super) fn march(
                 .map(|&(i, o)| {
                     let key = (ids[i].min(ids[o]), ids[i].max(ids[o]));
                     *roots.entry(key).or_insert_with(|| {
-                        crossings
-                            .push((grid.vertex_point(corners[i]), grid.vertex_point(corners[o])));
+                        crossings.push((ids[i], ids[o]));
                         (crossings.len() - 1) as u32
                     })
                 })
@@ -144,15 +148,33 @@ pub(super) fn march(
             loops.push(loop_ids);
         }
     }
-    // Solved on every core, then taken in order, so that a failure reported is the first edge's.
-    let solved: Vec<Result<(Point3<f64>, usize), MeshError>> = crossings
+    // The leaves' values at each end, taken once per grid vertex: a vertex ends four crossing edges on average.
+    let mut ends: Vec<u64> = crossings.iter().flat_map(|&(i, o)| [i, o]).collect();
+    ends.sort_unstable();
+    ends.dedup();
+    let end_values: Vec<(Point3<f64>, LeafValues)> = ends
         .par_iter()
-        .map(|(inside, outside)| edge_root(leaves, *inside, *outside, epsilon))
+        .map(|&id| {
+            let p = grid.vertex_point(grid.vertex_ijk(id));
+            (p, leaves.values(&p))
+        })
         .collect();
-    let solved: Vec<(Point3<f64>, usize)> = solved.into_iter().collect::<Result<_, _>>()?;
+    let end = |id: u64| {
+        let k = ends
+            .binary_search(&id)
+            .expect("every crossing's end is listed");
+        (end_values[k].0, &end_values[k].1)
+    };
+    // Solved on every core, then taken in order, so that a failure reported is the first edge's.
+    let solved: Vec<Result<Root, MeshError>> = crossings
+        .par_iter()
+        .map(|&(inside, outside)| edge_root(leaves, end(inside), end(outside), epsilon))
+        .collect();
+    let solved: Vec<Root> = solved.into_iter().collect::<Result<_, _>>()?;
     let mut surface = Surface {
-        vertices: solved.iter().map(|(point, _)| *point).collect(),
-        on: solved.iter().map(|(_, leaf)| (*leaf, *leaf)).collect(),
+        vertices: solved.iter().map(|root| root.point).collect(),
+        on: solved.iter().map(|root| (root.leaf, root.leaf)).collect(),
+        checked: solved.iter().map(|root| root.on_surface).collect(),
         triangles: Vec::new(),
     };
     for loop_ids in &loops {
@@ -182,62 +204,91 @@ fn push_polygon(surface: &mut Surface, ids: &[u32]) {
 /// Halvings of a grid edge while more than one primitive changes sign along it.
 const MAX_HALVINGS: u32 = 60;
 
-/// The point where the solid's sign flips between `inside` (in) and `outside`, with the primitive
-/// whose surface holds it. While several primitives change sign along the segment it is halved,
-/// keeping the half where the solid's sign flips; then the one primitive left is solved on the
-/// segment by regula falsi (`regula_falsi`) until |f| is far below epsilon.
+/// A grid edge's root: the point, the primitive whose surface holds it, and whether the leaves' values there
+/// proved |F| < epsilon.
+struct Root {
+    point: Point3<f64>,
+    leaf: usize,
+    on_surface: bool,
+}
+
+/// The point where the solid's sign flips between `inside` (in) and `outside`, given with their leaves' values,
+/// with the primitive whose surface holds it. While several primitives change sign along the segment it is
+/// halved, keeping the half where the solid's sign flips; then the one primitive left is solved on the segment
+/// by regula falsi (`regula_falsi`) until |f| is far below epsilon.
 fn edge_root(
     leaves: &Leaves,
-    inside: Point3<f64>,
-    outside: Point3<f64>,
+    inside: (Point3<f64>, &LeafValues),
+    outside: (Point3<f64>, &LeafValues),
     epsilon: f64,
-) -> Result<(Point3<f64>, usize), MeshError> {
-    let (mut a, mut b) = (inside, outside);
-    let (mut sa, mut sb) = (leaves.signs(&a), leaves.signs(&b));
+) -> Result<Root, MeshError> {
+    let ((mut a, mut va), (mut b, mut vb)) = (
+        (inside.0, Cow::Borrowed(inside.1)),
+        (outside.0, Cow::Borrowed(outside.1)),
+    );
     for _ in 0..MAX_HALVINGS {
-        let flipped: Vec<usize> = (0..sa.len()).filter(|&i| sa[i] != sb[i]).collect();
-        if let [leaf] = flipped[..] {
+        if let [leaf] = va.flipped(&vb)[..] {
             // The other primitives agree at both ends, but one of them may still be entered and
             // left in between (an edge clipping a box's corner): the root counts only where
             // they all keep their end signs; otherwise halve on.
-            let root = solve_on_segment(leaves, leaf, a, b, epsilon)?;
-            let at_root = leaves.signs(&root);
-            if (0..sa.len()).all(|k| k == leaf || at_root[k] == sa[k]) {
-                return Ok((root, leaf));
+            let (point, value) = solve_on_segment(
+                leaves,
+                leaf,
+                (a, va.value(leaf)),
+                (b, vb.value(leaf)),
+                epsilon,
+            )?;
+            let mut at_root = leaves.values_except(&point, Some(leaf));
+            if at_root.flipped(&va).iter().all(|&k| k == leaf) {
+                at_root.insert(leaf, value);
+                let on_surface = leaves.values_prove_on_surface(&point, &at_root, epsilon);
+                return Ok(Root {
+                    point,
+                    leaf,
+                    on_surface,
+                });
             }
         }
         let m = nalgebra::center(&a, &b);
-        let sm = leaves.signs(&m);
-        if leaves.classify(&sm) {
-            (a, sa) = (m, sm);
+        let vm = Cow::Owned(leaves.values(&m));
+        if leaves.classify(&vm) {
+            (a, va) = (m, vm);
         } else {
-            (b, sb) = (m, sm);
+            (b, vb) = (m, vm);
         }
     }
     // The segment has shrunk to rounding: several surfaces meet here. Keep the primitive that is
     // closest to zero; the tree's residual is checked on every vertex at the end.
     let m = nalgebra::center(&a, &b);
-    let leaf = (0..sa.len())
-        .filter(|&i| sa[i] != sb[i])
+    let leaf = va
+        .flipped(&vb)
+        .into_iter()
         .min_by(|&i, &j| {
             let (fi, fj) = (leaves.leaves[i].value(&m), leaves.leaves[j].value(&m));
             fi.abs().total_cmp(&fj.abs())
         })
         .ok_or(MeshError::NoRoot { near: m })?;
-    Ok((m, leaf))
+    Ok(Root {
+        point: m,
+        leaf,
+        on_surface: false,
+    })
 }
 
 /// The root of one primitive's function along [a, b], where it changes sign.
+/// The ends come with the leaf's values there where they are known (its box holds them). The root comes with
+/// the leaf's value there.
 fn solve_on_segment(
     leaves: &Leaves,
     leaf: usize,
-    a: Point3<f64>,
-    b: Point3<f64>,
+    (a, fa): (Point3<f64>, Option<f64>),
+    (b, fb): (Point3<f64>, Option<f64>),
     epsilon: f64,
-) -> Result<Point3<f64>, MeshError> {
+) -> Result<(Point3<f64>, f64), MeshError> {
     let at = |t: f64| a + (b - a) * t;
     let f = |t: f64| leaves.leaves[leaf].value(&at(t));
-    regula_falsi::root(f, (f(0.0), f(1.0)), 1e-3 * epsilon)
-        .map(at)
+    let ends = (fa.unwrap_or_else(|| f(0.0)), fb.unwrap_or_else(|| f(1.0)));
+    regula_falsi::root(f, ends, 1e-3 * epsilon)
+        .map(|(t, value)| (at(t), value))
         .ok_or(MeshError::NoRoot { near: a })
 }
