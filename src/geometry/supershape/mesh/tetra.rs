@@ -11,8 +11,6 @@
 
 use std::borrow::Cow;
 
-use foldhash::{HashMap, HashMapExt};
-
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
@@ -47,110 +45,50 @@ const TETRAHEDRA: [[usize; 4]; 6] = [
     [0, 4, 6, 7],
 ];
 
-/// The surface in the band's cells. The corners' signs and the edges' roots, the costly part,
-/// are found on every core; which edges cross and how their vertices join is decided in one pass
-/// over the cells in order, so the mesh (or the error) is the same whatever the number of cores.
+/// The surface in the band's cells, found on every core: the corners' signs, each crossed cell's pieces of
+/// surface (by the grid edges they cross), the edges' roots. The crossed edges are numbered in the order of
+/// their keys and the pieces kept in the order of the cells, so the mesh (or the error) is the same whatever the
+/// number of cores.
 pub(super) fn march(
     leaves: &Leaves,
     grid: &Grid,
     cells: &[[u64; 3]],
     epsilon: f64,
 ) -> Result<Surface, MeshError> {
-    let corners_of = |cell: &[u64; 3]| -> [[u64; 3]; 8] {
-        std::array::from_fn(|c| [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis]))
-    };
     // The cells' corners as bits over the grid's vertices (their ids in order, no sort), their signs as bits.
     let corners = Bits::new(grid.vertex_count());
-    for cell in cells {
-        for ijk in corners_of(cell) {
-            corners.insert(grid.vertex_id(ijk));
+    cells.par_iter().for_each(|cell| {
+        for c in 0..8 {
+            corners.insert(grid.vertex_id(corner(cell, c)));
         }
-    }
+    });
     let ids: Vec<u64> = corners.iter().collect();
-    let inside_flags: Vec<bool> = ids
-        .par_iter()
-        .map(|&id| leaves.inside(&grid.vertex_point(grid.vertex_ijk(id))))
-        .collect();
     let signs = Bits::new(grid.vertex_count());
-    for (&id, _) in ids.iter().zip(&inside_flags).filter(|(_, &inside)| inside) {
-        signs.insert(id);
-    }
-    let mut roots: HashMap<(u64, u64), u32> = HashMap::new();
-    // The grid edges whose roots are wanted, (inside end, outside end) by vertex id, in vertex order.
-    let mut crossings: Vec<(u64, u64)> = Vec::new();
-    let mut loops: Vec<Vec<u32>> = Vec::new();
-    for cell in cells {
-        let corners = corners_of(cell);
-        let ids = corners.map(|ijk| grid.vertex_id(ijk));
-        let inside: [bool; 8] = std::array::from_fn(|c| signs.contains(ids[c]));
-        if inside.iter().all(|&s| s == inside[0]) {
-            continue;
-        }
-        for tet in TETRAHEDRA {
-            // Fixed arrays, not vectors: this runs for every tetrahedron of every crossed cell.
-            let (mut ins, mut outs) = ([0; 4], [0; 4]);
-            let (mut n_in, mut n_out) = (0, 0);
-            for c in tet {
-                if inside[c] {
-                    ins[n_in] = c;
-                    n_in += 1;
-                } else {
-                    outs[n_out] = c;
-                    n_out += 1;
-                }
+    ids.par_iter()
+        .filter(|&&id| leaves.inside(&grid.vertex_point(grid.vertex_ijk(id))))
+        .for_each(|&id| signs.insert(id));
+    let pieces: Vec<Piece> = cells
+        .par_iter()
+        .flat_map_iter(|cell| cell_pieces(grid, &signs, cell).into_iter().flatten())
+        .collect();
+    let mut edges: Vec<u64> = pieces.iter().flat_map(Piece::edges).collect();
+    edges.par_sort_unstable();
+    edges.dedup();
+    // Each crossed edge as (inside end, outside end) by vertex id.
+    let crossings: Vec<(u64, u64)> = edges
+        .par_iter()
+        .map(|&key| {
+            let (low, high) = edge_ends(grid, key);
+            if signs.contains(low) {
+                (low, high)
+            } else {
+                (high, low)
             }
-            if n_in == 0 || n_out == 0 {
-                continue;
-            }
-            let (ins, outs) = (&ins[..n_in], &outs[..n_out]);
-            // The surface's corners in cyclic order: a triangle around a lone corner, or the
-            // quadrilateral between two inside and two outside corners.
-            let (quad, triangle);
-            let edges: &[(usize, usize)] = match (n_in, n_out) {
-                (1, _) => {
-                    triangle = [(ins[0], outs[0]), (ins[0], outs[1]), (ins[0], outs[2])];
-                    &triangle
-                }
-                (_, 1) => {
-                    triangle = [(ins[0], outs[0]), (ins[1], outs[0]), (ins[2], outs[0])];
-                    &triangle
-                }
-                _ => {
-                    quad = [
-                        (ins[0], outs[0]),
-                        (ins[0], outs[1]),
-                        (ins[1], outs[1]),
-                        (ins[1], outs[0]),
-                    ];
-                    &quad
-                }
-            };
-            // Orientation from the edges' midpoints in grid units (never degenerate, unlike the
-            // roots, which may crowd at a corner): normals point from inside to outside.
-            let offset = |c: usize| Vector3::from(corner_offset(c).map(|v| v as f64));
-            let mid = |(a, b): (usize, usize)| (offset(a) + offset(b)) * 0.5;
-            let outward = outs.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / outs.len() as f64
-                - ins.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / ins.len() as f64;
-            let normal = (mid(edges[1]) - mid(edges[0])).cross(&(mid(edges[2]) - mid(edges[0])));
-            let mut loop_ids: Vec<u32> = edges
-                .iter()
-                .map(|&(i, o)| {
-                    let key = (ids[i].min(ids[o]), ids[i].max(ids[o]));
-                    *roots.entry(key).or_insert_with(|| {
-                        crossings.push((ids[i], ids[o]));
-                        (crossings.len() - 1) as u32
-                    })
-                })
-                .collect();
-            if normal.dot(&outward) < 0.0 {
-                loop_ids.reverse();
-            }
-            loops.push(loop_ids);
-        }
-    }
+        })
+        .collect();
     // The leaves' values at each end, taken once per grid vertex: a vertex ends four crossing edges on average.
     let mut ends: Vec<u64> = crossings.iter().flat_map(|&(i, o)| [i, o]).collect();
-    ends.sort_unstable();
+    ends.par_sort_unstable();
     ends.dedup();
     let end_values: Vec<(Point3<f64>, LeafValues)> = ends
         .par_iter()
@@ -177,10 +115,119 @@ pub(super) fn march(
         checked: solved.iter().map(|root| root.on_surface).collect(),
         triangles: Vec::new(),
     };
+    let vertex_of = |key: &u64| {
+        edges
+            .binary_search(key)
+            .expect("every crossed edge is listed") as u32
+    };
+    let loops: Vec<Vec<u32>> = pieces
+        .par_iter()
+        .map(|piece| piece.edges().map(|key| vertex_of(&key)).collect())
+        .collect();
     for loop_ids in &loops {
         push_polygon(&mut surface, loop_ids);
     }
     Ok(surface)
+}
+
+/// Corner c of a cell.
+fn corner(cell: &[u64; 3], c: usize) -> [u64; 3] {
+    [0, 1, 2].map(|axis| cell[axis] + corner_offset(c)[axis])
+}
+
+/// A grid edge of the Kuhn triangulation by one number: its lower end's vertex id times 8 plus the set of axes
+/// along which its upper end is one step further (1 to 7: the cube's edges, face diagonals and main diagonal).
+/// Both ends of every edge of a Kuhn tetrahedron are so ordered, as its corners lie on a monotone path.
+fn edge_key(grid: &Grid, cell: &[u64; 3], low: usize, high: usize) -> u64 {
+    debug_assert!(low & high == low && low != high);
+    grid.vertex_id(corner(cell, low)) * 8 + (high ^ low) as u64
+}
+
+/// The vertex ids of an edge's lower and upper ends.
+fn edge_ends(grid: &Grid, key: u64) -> (u64, u64) {
+    let low = key / 8;
+    let ijk = grid.vertex_ijk(low);
+    (low, grid.vertex_id(corner(&ijk, (key % 8) as usize)))
+}
+
+/// The piece of surface in one tetrahedron: the grid edges it crosses, by key, in cyclic order (a triangle round
+/// a lone corner, or the quadrilateral between two inside and two outside corners), turned so that its normal
+/// points from inside to outside.
+struct Piece {
+    edges: [u64; 4],
+    count: usize,
+}
+
+impl Piece {
+    fn edges(&self) -> impl Iterator<Item = u64> + '_ {
+        self.edges[..self.count].iter().copied()
+    }
+}
+
+/// The pieces of surface in one cell's six tetrahedra: none unless its corners' signs differ.
+fn cell_pieces(grid: &Grid, signs: &Bits, cell: &[u64; 3]) -> [Option<Piece>; 6] {
+    let inside: [bool; 8] =
+        std::array::from_fn(|c| signs.contains(grid.vertex_id(corner(cell, c))));
+    if inside.iter().all(|&s| s == inside[0]) {
+        return Default::default();
+    }
+    TETRAHEDRA.map(|tet| {
+        // Fixed arrays, not vectors: this runs for every tetrahedron of every crossed cell.
+        let (mut ins, mut outs) = ([0; 4], [0; 4]);
+        let (mut n_in, mut n_out) = (0, 0);
+        for c in tet {
+            if inside[c] {
+                ins[n_in] = c;
+                n_in += 1;
+            } else {
+                outs[n_out] = c;
+                n_out += 1;
+            }
+        }
+        if n_in == 0 || n_out == 0 {
+            return None;
+        }
+        let (ins, outs) = (&ins[..n_in], &outs[..n_out]);
+        let (quad, triangle);
+        let corners: &[(usize, usize)] = match (n_in, n_out) {
+            (1, _) => {
+                triangle = [(ins[0], outs[0]), (ins[0], outs[1]), (ins[0], outs[2])];
+                &triangle
+            }
+            (_, 1) => {
+                triangle = [(ins[0], outs[0]), (ins[1], outs[0]), (ins[2], outs[0])];
+                &triangle
+            }
+            _ => {
+                quad = [
+                    (ins[0], outs[0]),
+                    (ins[0], outs[1]),
+                    (ins[1], outs[1]),
+                    (ins[1], outs[0]),
+                ];
+                &quad
+            }
+        };
+        // Orientation from the edges' midpoints in grid units (never degenerate, unlike the
+        // roots, which may crowd at a corner): normals point from inside to outside.
+        let offset = |c: usize| Vector3::from(corner_offset(c).map(|v| v as f64));
+        let mid = |(a, b): (usize, usize)| (offset(a) + offset(b)) * 0.5;
+        let outward = outs.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / outs.len() as f64
+            - ins.iter().map(|&c| offset(c)).sum::<Vector3<f64>>() / ins.len() as f64;
+        let normal =
+            (mid(corners[1]) - mid(corners[0])).cross(&(mid(corners[2]) - mid(corners[0])));
+        let mut edges = [0; 4];
+        for (k, &(i, o)) in corners.iter().enumerate() {
+            edges[k] = edge_key(grid, cell, i.min(o), i.max(o));
+        }
+        if normal.dot(&outward) < 0.0 {
+            edges[..corners.len()].reverse();
+        }
+        Some(Piece {
+            edges,
+            count: corners.len(),
+        })
+    })
 }
 
 /// A triangle, or a quadrilateral cut along its shorter diagonal (either cut keeps the loop's
@@ -291,4 +338,53 @@ fn solve_on_segment(
     regula_falsi::root(f, ends, 1e-3 * epsilon)
         .map(|(t, value)| (at(t), value))
         .ok_or(MeshError::NoRoot { near: a })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::csg::Aabb;
+    use super::*;
+    use std::collections::HashMap;
+
+    #[test]
+    fn edge_keys_name_each_grid_edge_once_and_give_back_its_ends() {
+        let grid = Grid::new(
+            &Aabb {
+                min: Point3::origin(),
+                max: Point3::new(3.0, 2.0, 4.0),
+            },
+            1.0,
+        );
+        // Every tetrahedron edge of every cell, from both of its cells' (or more) views.
+        let mut by_key: HashMap<u64, (u64, u64)> = HashMap::new();
+        for cell in (0..4).flat_map(|i| (0..3).flat_map(move |j| (0..5).map(move |k| [i, j, k]))) {
+            for tet in TETRAHEDRA {
+                for (x, &a) in tet.iter().enumerate() {
+                    for &b in &tet[x + 1..] {
+                        let key = edge_key(&grid, &cell, a, b);
+                        let ends = (
+                            grid.vertex_id(corner(&cell, a)),
+                            grid.vertex_id(corner(&cell, b)),
+                        );
+                        assert_eq!(edge_ends(&grid, key), ends);
+                        assert_eq!(*by_key.entry(key).or_insert(ends), ends);
+                    }
+                }
+            }
+        }
+        // One key per edge: as many keys as distinct pairs of ends.
+        let mut pairs: Vec<(u64, u64)> = by_key.values().copied().collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        assert_eq!(pairs.len(), by_key.len());
+        // Kuhn's tetrahedra use 19 of a cube's 28 segments (its 12 edges, one diagonal of each face, one main
+        // diagonal): from each vertex of the 5 x 4 x 6 lattice of these 4 x 3 x 5 cells, the 7 to it + mask that
+        // stay in the lattice.
+        let mut expected = 0;
+        for mask in 1..8u64 {
+            let [dx, dy, dz] = [mask & 1, mask >> 1 & 1, mask >> 2 & 1];
+            expected += (5 - dx) * (4 - dy) * (6 - dz);
+        }
+        assert_eq!(by_key.len() as u64, expected);
+    }
 }
