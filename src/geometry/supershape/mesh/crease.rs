@@ -91,15 +91,12 @@ fn choose_splits(
     surface: &Surface,
     decide: impl Fn(&Surface, usize, usize) -> Option<Split> + Sync,
 ) -> HashMap<(u32, u32), Split> {
-    let edges: Vec<(u32, u32)> = surface
+    surface
         .triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .filter(|(a, b)| a < b)
-        .collect();
-    edges
         .par_iter()
-        .filter_map(|&(a, b)| decide(surface, a as usize, b as usize).map(|split| ((a, b), split)))
+        .flat_map_iter(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter(|(a, b)| a < b)
+        .filter_map(|(a, b)| decide(surface, a as usize, b as usize).map(|split| ((a, b), split)))
         .collect::<Vec<_>>()
         .into_iter()
         .collect()
@@ -111,6 +108,13 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
     let mut inserted = HashMap::with_capacity(splits.len());
     let mut keys: Vec<_> = splits.keys().copied().collect();
     keys.sort_unstable();
+    // A triangle with fewer than two ends of split edges among its corners keeps its shape: most of them, which
+    // then need no look-up of their edges.
+    let mut split_end = vec![false; surface.vertices.len()];
+    for &(a, b) in &keys {
+        split_end[a as usize] = true;
+        split_end[b as usize] = true;
+    }
     for key in keys {
         let (point, (i, j)) = splits[&key];
         surface.vertices.push(point);
@@ -123,6 +127,10 @@ fn apply_splits(surface: &mut Surface, splits: HashMap<(u32, u32), Split>) {
     let old = std::mem::take(&mut surface.triangles);
     let mut triangles = Vec::with_capacity(old.len() + 4 * inserted.len());
     for t in old {
+        if t.iter().filter(|&&v| split_end[v as usize]).count() < 2 {
+            triangles.push(t);
+            continue;
+        }
         let mids: [Option<u32>; 3] = std::array::from_fn(|k| split_of(t[k], t[(k + 1) % 3]));
         let count = mids.iter().flatten().count();
         // Rotate so that the split edges come first: mids[0] for a single split, mids[0] and
