@@ -125,7 +125,9 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
         .par_iter()
         .for_each(|(i, patch)| sample_base_patch(&leaves.leaves[*i], patch, grid, &sampled));
     let band = Bits::new(grid.cell_count());
-    for c in sampled.iter().map(|id| grid.cell_ijk(id)) {
+    let sampled: Vec<u64> = sampled.iter().collect();
+    sampled.par_iter().for_each(|&id| {
+        let c = grid.cell_ijk(id);
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -136,7 +138,7 @@ pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
                 }
             }
         }
-    }
+    });
     band.iter().map(|id| grid.cell_ijk(id)).collect()
 }
 
