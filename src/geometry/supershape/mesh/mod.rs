@@ -30,6 +30,7 @@ mod band;
 mod crease;
 mod export;
 pub mod hub;
+mod keys;
 mod leaves;
 mod regula_falsi;
 mod tetra;

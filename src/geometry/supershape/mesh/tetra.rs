@@ -15,6 +15,7 @@ use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::band::{Bits, Grid};
+use super::keys::SortedKeys;
 use super::leaves::{LeafValues, Leaves};
 use super::regula_falsi;
 use super::MeshError;
@@ -71,11 +72,10 @@ pub(super) fn march(
         .par_iter()
         .flat_map_iter(|cell| cell_pieces(grid, &signs, cell).into_iter().flatten())
         .collect();
-    let mut edges: Vec<u64> = pieces.iter().flat_map(Piece::edges).collect();
-    edges.par_sort_unstable();
-    edges.dedup();
+    let edges = SortedKeys::new(pieces.par_iter().flat_map_iter(Piece::edges).collect());
     // Each crossed edge as (inside end, outside end) by vertex id.
     let crossings: Vec<(u64, u64)> = edges
+        .keys()
         .par_iter()
         .map(|&key| {
             let (low, high) = edge_ends(grid, key);
@@ -87,10 +87,14 @@ pub(super) fn march(
         })
         .collect();
     // The leaves' values at each end, taken once per grid vertex: a vertex ends four crossing edges on average.
-    let mut ends: Vec<u64> = crossings.iter().flat_map(|&(i, o)| [i, o]).collect();
-    ends.par_sort_unstable();
-    ends.dedup();
+    let ends = SortedKeys::new(
+        crossings
+            .par_iter()
+            .flat_map_iter(|&(i, o)| [i, o])
+            .collect(),
+    );
     let end_values: Vec<(Point3<f64>, LeafValues)> = ends
+        .keys()
         .par_iter()
         .map(|&id| {
             let p = grid.vertex_point(grid.vertex_ijk(id));
@@ -98,9 +102,7 @@ pub(super) fn march(
         })
         .collect();
     let end = |id: u64| {
-        let k = ends
-            .binary_search(&id)
-            .expect("every crossing's end is listed");
+        let k = ends.position(id).expect("every crossing's end is listed");
         (end_values[k].0, &end_values[k].1)
     };
     // Solved on every core, then taken in order, so that a failure reported is the first edge's.
@@ -115,17 +117,21 @@ pub(super) fn march(
         checked: solved.iter().map(|root| root.on_surface).collect(),
         triangles: Vec::new(),
     };
-    let vertex_of = |key: &u64| {
-        edges
-            .binary_search(key)
-            .expect("every crossed edge is listed") as u32
-    };
-    let loops: Vec<Vec<u32>> = pieces
+    let vertex_of = |key: u64| edges.position(key).expect("every crossed edge is listed") as u32;
+    let loops: Vec<[u32; 4]> = pieces
         .par_iter()
-        .map(|piece| piece.edges().map(|key| vertex_of(&key)).collect())
+        .map(|piece| {
+            std::array::from_fn(|k| {
+                if k < piece.count {
+                    vertex_of(piece.edges[k])
+                } else {
+                    0
+                }
+            })
+        })
         .collect();
-    for loop_ids in &loops {
-        push_polygon(&mut surface, loop_ids);
+    for (loop_ids, piece) in loops.iter().zip(&pieces) {
+        push_polygon(&mut surface, &loop_ids[..piece.count]);
     }
     Ok(surface)
 }
