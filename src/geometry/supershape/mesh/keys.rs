@@ -47,10 +47,11 @@ impl SortedKeys {
 
     /// The key's index in increasing order, if it is in the set.
     pub fn position(&self, key: u64) -> Option<usize> {
-        let group = (key >> self.shift) as usize;
-        if group + 1 >= self.directory.len() {
+        let group = key >> self.shift;
+        if group >= self.directory.len() as u64 - 1 {
             return None;
         }
+        let group = group as usize;
         let (start, end) = (
             self.directory[group] as usize,
             self.directory[group + 1] as usize,
