@@ -21,10 +21,11 @@
 //!    which leaves mesh edges running along the curve; curve edges longer than delta are split
 //!    again on the curve. Splits keep the mesh closed.
 //!
-//! Every vertex is then checked on the whole tree's function: |F(v)| < epsilon, or the mesh is
-//! refused (proved from bounds of F built from the primitives whose boxes hold the vertex, or, where those do not
-//! prove it, by F's value). Features thinner than a grid cell can be missed (the mesh stays closed but loses
-//! them): the cell must resolve the part's thinnest wall and smallest hole.
+//! Every vertex is checked on the whole tree's function: |F(v)| < epsilon, or the mesh is refused. It is proved
+//! from bounds of F built from the primitives whose boxes hold the vertex (taken where the vertex was made, from
+//! the values its own step computed, or at the end), or, where those do not prove it, by F's value. Features
+//! thinner than a grid cell can be missed (the mesh stays closed but loses them): the cell must resolve the
+//! part's thinnest wall and smallest hole.
 
 mod band;
 mod crease;
