@@ -105,14 +105,15 @@ const BASE_FACE: usize = 4;
 const MAX_DEPTH: u32 = 28;
 
 /// Every cell within one cell of a parametric sample of a primitive's surface, in the order of their lowest
-/// vertices' ids (z, then y, then x). Patches are split until their diagonals are at most a cell long: a point
-/// of a flat patch then lies within half a cell of one of its corners, and of a patch folded at a right angle
-/// (a box's edge, a near-square profile's rim) within 0.71 of a cell. A point less than a cell from a sample
-/// lies in a cell at most one step from the sample's along each axis, a neighbour: every cell the surface
-/// crosses is in the band. (Splitting down to half a cell sampled four times as many points for the same band
-/// on the brake hub at 1 and 0.5 mm.) The base patches of every primitive are sampled on every core (one large
-/// primitive, the rim of a hub, would otherwise keep one core busy alone); the cells are marked in bit sets over
-/// the grid.
+/// vertices' ids (z, then y, then x). A point less than a cell from a sample lies in a cell at most one step from
+/// the sample's along each axis, a neighbour: every cell the surface crosses is in the band as long as every
+/// surface point lies within a cell of a sample. Patches are split until their diagonals are at most half a
+/// cell (see `split_patch`): a point of a flat patch then lies within 0.36 of a cell of a corner (0.71 of the
+/// diagonal, for a patch shaped as a triangle at a pole), of a patch folded with an interior angle of 29 deg or
+/// more (a box's edge, a star profile's tip) within a cell. Where the patch's parent was flat they stop at one
+/// cell: a quarter of the samples where most of a part is walls and caps. The base patches of every primitive are
+/// sampled on every core (one large primitive, the rim of a hub, would otherwise keep one core busy alone); the
+/// cells are marked in bit sets over the grid.
 pub(super) fn band(leaves: &Leaves, grid: &Grid) -> Vec<[u64; 3]> {
     let patches: Vec<(usize, BasePatch)> = leaves
         .leaves
@@ -261,11 +262,19 @@ fn sample_patch(
         surface(u1, v1),
         surface(u0, v1),
     ];
-    split_patch(surface, [u0, u1, v0, v1], &corners, cell, 0, mark);
+    split_patch(surface, [u0, u1, v0, v1], &corners, cell, false, 0, mark);
 }
 
+/// How far (in cells) the surface may stray from the bilinear patch through a patch's corners, at the points its
+/// split computes, for its children to stop at a one-cell diagonal: a point of such a child then lies within
+/// 0.71 + 0.1 of a cell of a corner, under the band's one-cell margin. A fold or tip inside the patch puts its
+/// split points far off the bilinear patch (a third of its size and more at a right angle).
+const FLAT: f64 = 0.1;
+
 /// One patch with its corners (in the order (u0, v0), (u1, v0), (u1, v1), (u0, v1)) already on the
-/// surface: marked, or split at its middle lines, the corners shared with the children. A patch much longer
+/// surface: marked, or split at its middle lines, the corners shared with the children. It is marked once its
+/// diagonals are at most half a cell, or at most a cell where its parent was found flat (`flat_parent`: every
+/// point the parent's split computed within `FLAT` cell of the parent's bilinear patch). A patch much longer
 /// along one parameter than the other (a cylinder's wall patch is 8 mm round and under 1 mm high) is split
 /// across that parameter only: split in four, its short side would be cut as often as its long one and sampled
 /// many times more finely than the cell needs.
@@ -274,13 +283,15 @@ fn split_patch(
     [u0, u1, v0, v1]: [f64; 4],
     corners: &[Point3<f64>; 4],
     cell: f64,
+    flat_parent: bool,
     depth: u32,
     mark: &mut impl FnMut(&Point3<f64>),
 ) {
     let spread = (corners[0] - corners[2])
         .norm()
         .max((corners[1] - corners[3]).norm());
-    if spread <= cell || depth == MAX_DEPTH {
+    let enough = if flat_parent { cell } else { 0.5 * cell };
+    if spread <= enough || depth == MAX_DEPTH {
         corners.iter().for_each(&mut *mark);
         return;
     }
@@ -288,21 +299,27 @@ fn split_patch(
     let [c00, c10, c11, c01] = *corners;
     let along_u = (c10 - c00).norm().max((c11 - c01).norm());
     let along_v = (c01 - c00).norm().max((c11 - c10).norm());
+    // How far a split point lies from the bilinear patch: from the middle of its edge, or of the corners.
+    let off = |p: Point3<f64>, ends: &[Point3<f64>]| {
+        (p.coords - ends.iter().map(|e| e.coords).sum::<Vector3<f64>>() / ends.len() as f64).norm()
+    };
     let (halves, quarters): ([Child; 2], [Child; 4]);
-    let children: &[Child] = if along_u > 2.0 * along_v {
+    let (children, stray): (&[Child], f64) = if along_u > 2.0 * along_v {
         let (bottom, top) = (surface(um, v0), surface(um, v1));
+        let stray = off(bottom, &[c00, c10]).max(off(top, &[c01, c11]));
         halves = [
             ([u0, um, v0, v1], [c00, bottom, top, c01]),
             ([um, u1, v0, v1], [bottom, c10, c11, top]),
         ];
-        &halves
+        (&halves, stray)
     } else if along_v > 2.0 * along_u {
         let (left, right) = (surface(u0, vm), surface(u1, vm));
+        let stray = off(left, &[c00, c01]).max(off(right, &[c10, c11]));
         halves = [
             ([u0, u1, v0, vm], [c00, c10, right, left]),
             ([u0, u1, vm, v1], [left, right, c11, c01]),
         ];
-        &halves
+        (&halves, stray)
     } else {
         let (bottom, right, top, left, middle) = (
             surface(um, v0),
@@ -317,12 +334,72 @@ fn split_patch(
             ([um, u1, vm, v1], [middle, right, c11, top]),
             ([u0, um, vm, v1], [left, middle, top, c01]),
         ];
-        &quarters
+        let stray = [
+            off(bottom, &[c00, c10]),
+            off(right, &[c10, c11]),
+            off(top, &[c01, c11]),
+            off(left, &[c00, c01]),
+            off(middle, corners),
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
+        (&quarters, stray)
     };
+    let flat = stray <= FLAT * cell;
     for (rect, corners) in children {
-        split_patch(surface, *rect, corners, cell, depth + 1, mark);
+        split_patch(surface, *rect, corners, cell, flat, depth + 1, mark);
     }
 }
 
 /// A sub-patch: its parameter rectangle and its corners on the surface.
 type Child = ([f64; 4], [Point3<f64>; 4]);
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::csg::{Node, Solid};
+    use super::super::super::deform::Deformations;
+    use super::super::super::formula::Superformula;
+    use super::super::super::shape::Supershape;
+    use super::*;
+
+    #[test]
+    fn every_point_of_stars_with_sharp_tips_lies_in_a_band_cell() {
+        // Profiles with tips of about 19, 44 and 67 deg (m, n1, n2, n3), 10 mm across, at a 1 mm cell; and a
+        // box-like shape whose edges are right angles. A patch that stopped at a one-cell diagonal across a tip
+        // left the tip's cells out of the band.
+        let profiles = [
+            (7.0, 0.3, 1.0, 1.0),
+            (5.0, 0.5, 1.0, 1.0),
+            (3.0, 0.5, 1.0, 1.5),
+            (4.0, 40.0, 40.0, 40.0),
+        ];
+        for (m, n1, n2, n3) in profiles {
+            let shape = Supershape {
+                r1: Superformula::new(m, n1, n2, n3, 1.0, 1.0).unwrap(),
+                r2: Superformula::circle(),
+                scale: [10.0; 3],
+            };
+            let solid = Solid::new(Node::supershape(shape, Deformations::default()));
+            let leaves = Leaves::new(&solid);
+            let grid = Grid::new(&solid.bounds(), 1.0);
+            let band: Vec<u64> = band(&leaves, &grid)
+                .into_iter()
+                .map(|c| grid.cell_id(c))
+                .collect();
+            let (n_theta, n_phi) = (4000, 400);
+            for i in 0..n_theta {
+                let theta = -PI + 2.0 * PI * (i as f64 + 0.5) / n_theta as f64;
+                for j in 0..=n_phi {
+                    let phi = -FRAC_PI_2 + PI * j as f64 / n_phi as f64;
+                    let p = shape.point(theta, phi);
+                    let cell = grid.cell_of(&p).map(|c| grid.cell_id(c));
+                    assert!(
+                        cell.is_some_and(|id| band.binary_search(&id).is_ok()),
+                        "profile {:?}: {p} (theta {theta}, phi {phi}) is in no band cell",
+                        (m, n1, n2, n3)
+                    );
+                }
+            }
+        }
+    }
+}
