@@ -72,7 +72,7 @@ impl<'a> Leaves<'a> {
         evaluate(&self.expr, values)
     }
 
-    /// The solid's inside/outside at a model point, as `classify(&signs(p))` but asking each leaf only when
+    /// The solid's inside/outside at a model point, as `classify(&values(p))` but asking each leaf only when
     /// the Boolean expression still depends on it (a union whose left side holds p needs no right side).
     pub fn inside(&self, p: &Point3<f64>) -> bool {
         self.inside_of(&self.expr, p)

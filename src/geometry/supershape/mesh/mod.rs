@@ -118,6 +118,7 @@ pub fn polygonise(solid: &Solid, params: &MeshParams) -> Result<TriMesh, MeshErr
     // where they were made, from the leaves' values there; the others' values are bounded from the primitives
     // near them (`Leaves::proves_on_surface`), and only a vertex whose bounds do not prove it is evaluated on the
     // whole tree.
+    debug_assert_eq!(surface.checked.len(), surface.vertices.len());
     let off_surface = surface
         .vertices
         .par_iter()

@@ -5,17 +5,17 @@
 
 const MAX_STEPS: u32 = 100;
 
-/// A t in [0, 1] with |f(t)| < `tolerance` (or the bracket closed to rounding), and f(t), given f's values at the
+/// A t in [0, 1] with |f(t)| < `tolerance` or f(t) = 0 (or the bracket closed to rounding), and f(t), given f's values at the
 /// ends, of opposite signs (or one of them 0). None if they have the same sign or it does not converge.
 pub(super) fn root(f: impl Fn(f64) -> f64, ends: (f64, f64), tolerance: f64) -> Option<(f64, f64)> {
     let ((mut t0, mut f0), (mut t1, mut f1)) = ((0.0, ends.0), (1.0, ends.1));
     if f0 * f1 > 0.0 || f0.is_nan() || f1.is_nan() {
         return None;
     }
-    if f0.abs() < tolerance {
+    if f0.abs() < tolerance || f0 == 0.0 {
         return Some((t0, f0));
     }
-    if f1.abs() < tolerance {
+    if f1.abs() < tolerance || f1 == 0.0 {
         return Some((t1, f1));
     }
     // Which end moved last: -1 the low one, 1 the high one.
@@ -27,7 +27,7 @@ pub(super) fn root(f: impl Fn(f64) -> f64, ends: (f64, f64), tolerance: f64) -> 
             (t0 * f1 - t1 * f0) / (f1 - f0)
         };
         let ft = f(t);
-        if ft.abs() < tolerance || t1 - t0 < 1e-15 {
+        if ft.abs() < tolerance || ft == 0.0 || t1 - t0 < 1e-15 {
             return Some((t, ft));
         }
         if (ft > 0.0) == (f0 > 0.0) {

@@ -338,7 +338,8 @@ fn solve_on_segment(
     (b, fb): (Point3<f64>, Option<f64>),
     epsilon: f64,
 ) -> Result<(Point3<f64>, f64), MeshError> {
-    let at = |t: f64| a + (b - a) * t;
+    // The ends exactly (a + (b - a) need not round to b): a root at an end carries that end's value.
+    let at = |t: f64| if t == 1.0 { b } else { a + (b - a) * t };
     let f = |t: f64| leaves.leaves[leaf].value(&at(t));
     let ends = (fa.unwrap_or_else(|| f(0.0)), fb.unwrap_or_else(|| f(1.0)));
     regula_falsi::root(f, ends, 1e-3 * epsilon)
