@@ -217,13 +217,18 @@ pub fn fit_ip<const N: usize>(
         (None, FitMethod::Orthogonal) => ORTHOGONAL_START_OFFSETS.to_vec(),
         (None, FitMethod::ThreeL | FitMethod::Ridge) => OFFSET_CANDIDATES.to_vec(),
     };
-    let index = BallIndex::new(&unit);
-    let mut offset_sets = OffsetSets::default();
-    let probes = SideProbes::new(
-        &unit,
-        normals,
-        offset_sets.get(&index, &unit, normals, PROBE_REACH),
-    );
+    // Every ladder of offsets at once, the side probes' with the candidates': they share one index and what each
+    // point's rungs found.
+    let mut largests = candidates.clone();
+    let probe_set = largests
+        .iter()
+        .position(|&l| l == PROBE_REACH)
+        .unwrap_or_else(|| {
+            largests.push(PROBE_REACH);
+            largests.len() - 1
+        });
+    let offset_sets = choose_offsets(&BallIndex::new(&unit), &unit, normals, &largests);
+    let probes = SideProbes::new(&unit, normals, &offset_sets[probe_set]);
     let monomials = Monomials::new(&basis);
     let data_rows = Reduced::of_rows(unit.len(), 1, basis.len(), |i, rows| {
         monomials.fill(&unit[i], rows.push(0.0))
@@ -238,8 +243,7 @@ pub fn fit_ip<const N: usize>(
         ),
     };
     let mut best: Option<Fitted<N>> = None;
-    for largest_offset in candidates {
-        let offsets = offset_sets.get(&index, &unit, normals, largest_offset);
+    for offsets in &offset_sets[..candidates.len()] {
         let (coeffs, condition_number) = solve_three_level(
             &monomials,
             &data_rows,
@@ -325,33 +329,6 @@ fn check_spread<const N: usize>(points: &[SVector<f64, N>]) -> Result<(), FitErr
         return Err(FitError::Degenerate { dims: N, what });
     }
     Ok(())
-}
-
-/// The offsets of each largest offset tried, computed once per fit (the side probes reach as far as the largest
-/// candidate).
-#[derive(Default)]
-struct OffsetSets {
-    sets: Vec<(f64, Vec<Offsets>)>,
-}
-
-impl OffsetSets {
-    fn get<const N: usize>(
-        &mut self,
-        index: &BallIndex<N>,
-        unit: &[SVector<f64, N>],
-        normals: &[SVector<f64, N>],
-        largest: f64,
-    ) -> &[Offsets] {
-        let at = match self.sets.iter().position(|(l, _)| *l == largest) {
-            Some(at) => at,
-            None => {
-                let offsets = choose_offsets(index, unit, normals, largest);
-                self.sets.push((largest, offsets));
-                self.sets.len() - 1
-            }
-        };
-        &self.sets[at].1
-    }
 }
 
 /// Segments across the data along each point's normal, from inside to outside, each end half-way to the medial

@@ -45,11 +45,16 @@ impl<const N: usize> BallIndex<N> {
         }
     }
 
-    /// Whether some point other than the one at index `except` lies strictly within `radius` of `centre` (the same
-    /// comparison, `|q - centre| < radius`, for every point it reaches). Stops at the first found.
-    pub(super) fn any_within(&self, centre: &SVector<f64, N>, radius: f64, except: usize) -> bool {
+    /// Some point other than the one at index `except` strictly within `radius` of `centre` (the same comparison,
+    /// `|q - centre| < radius`, for every point it reaches), by its index in the input; the first found.
+    pub(super) fn one_within(
+        &self,
+        centre: &SVector<f64, N>,
+        radius: f64,
+        except: usize,
+    ) -> Option<usize> {
         if self.nodes.is_empty() {
-            return false;
+            return None;
         }
         // A box is skipped only when it is clearly farther than the radius: a point at the radius itself, within
         // rounding, is left to the exact comparison.
@@ -77,16 +82,16 @@ impl<const N: usize> BallIndex<N> {
                     depth += 2;
                 }
                 None => {
-                    let hit = (node.start..node.end).any(|j| {
+                    let hit = (node.start..node.end).find(|&j| {
                         self.original[j] != except && (self.points[j] - centre).norm() < radius
                     });
-                    if hit {
-                        return true;
+                    if let Some(j) = hit {
+                        return Some(self.original[j]);
                     }
                 }
             }
         }
-        false
+        None
     }
 }
 
@@ -168,12 +173,17 @@ mod tests {
                 curve[except] + Vector2::new(rng.gen_range(-0.1..0.1), rng.gen_range(-0.1..0.1));
             let radius = rng.gen_range(1e-6..0.2);
             let expected = by_every_point(&curve, &centre, radius, except);
-            assert_eq!(curve_index.any_within(&centre, radius, except), expected);
+            let found = curve_index.one_within(&centre, radius, except);
+            assert_eq!(found.is_some(), expected);
+            // The point named is one that counts.
+            if let Some(j) = found {
+                assert!(j != except && (curve[j] - centre).norm() < radius);
+            }
             checked.0 += usize::from(expected);
             // A ball through a point exactly: strictly within excludes it.
             let through = (curve[(except + 1) % curve.len()] - centre).norm();
             assert_eq!(
-                curve_index.any_within(&centre, through, except),
+                curve_index.one_within(&centre, through, except).is_some(),
                 by_every_point(&curve, &centre, through, except)
             );
         }
@@ -183,20 +193,31 @@ mod tests {
             let centre = planes[except] + Vector3::new(rng.gen_range(-0.5..0.5), 0.01, -0.02);
             let radius = rng.gen_range(1e-3..1.0);
             let expected = by_every_point(&planes, &centre, radius, except);
-            assert_eq!(index.any_within(&centre, radius, except), expected);
+            assert_eq!(
+                index.one_within(&centre, radius, except).is_some(),
+                expected
+            );
             checked.1 += usize::from(expected);
         }
         // Both answers were met often enough to mean something.
         assert!(checked.0 > 400 && checked.0 < 3_600, "{checked:?}");
         assert!(checked.1 > 200 && checked.1 < 1_800, "{checked:?}");
-        assert!(!BallIndex::<2>::new(&[]).any_within(&Vector2::zeros(), 1.0, 0));
+        assert!(BallIndex::<2>::new(&[])
+            .one_within(&Vector2::zeros(), 1.0, 0)
+            .is_none());
         // The point left out is the one given, by its index in the input: a tiny ball on a point holds only it,
         // and a copy of it at another index counts.
         let lone = 1_234;
-        assert!(!curve_index.any_within(&curve[lone], 1e-9, lone));
-        assert!(curve_index.any_within(&curve[lone], 1e-9, lone + 1));
+        assert_eq!(curve_index.one_within(&curve[lone], 1e-9, lone), None);
+        assert_eq!(
+            curve_index.one_within(&curve[lone], 1e-9, lone + 1),
+            Some(lone)
+        );
         let mut doubled = curve.clone();
         doubled.push(curve[lone]);
-        assert!(BallIndex::new(&doubled).any_within(&curve[lone], 1e-9, lone));
+        assert_eq!(
+            BallIndex::new(&doubled).one_within(&curve[lone], 1e-9, lone),
+            Some(doubled.len() - 1)
+        );
     }
 }
