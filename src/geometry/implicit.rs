@@ -10,7 +10,7 @@ use super::poly::Poly;
 use super::taylor::Taylor;
 
 /// What the distance and sampling code needs of a model: the value and its first and second derivatives.
-pub trait Implicit<const N: usize> {
+pub trait Implicit<const N: usize>: Sync {
     fn value(&self, p: &SVector<f64, N>) -> f64 {
         self.value_gradient(p).0
     }

@@ -153,15 +153,25 @@ impl<const N: usize> ZeroSetSamples<N> {
             return 0;
         }
         let data_index = PointIndex::new(data);
-        let mut closest = vec![f64::INFINITY; self.components];
-        for (sample, &component) in grid_samples.iter().zip(&self.component_of) {
-            if carries[component] {
-                continue;
-            }
-            if let Some(j) = data_index.nearest(sample) {
-                closest[component] = closest[component].min((data[j] - sample).norm());
-            }
-        }
+        // The samples in parallel too (a nearest search beside a dense scan is long); a minimum is the same in
+        // any order.
+        let closest = grid_samples
+            .par_iter()
+            .zip(&self.component_of)
+            .filter(|(_, &component)| !carries[component])
+            .fold(
+                || vec![f64::INFINITY; self.components],
+                |mut closest, (sample, &component)| {
+                    if let Some(j) = data_index.nearest(sample) {
+                        closest[component] = closest[component].min((data[j] - sample).norm());
+                    }
+                    closest
+                },
+            )
+            .reduce(
+                || vec![f64::INFINITY; self.components],
+                |a, b| a.iter().zip(&b).map(|(a, b)| a.min(*b)).collect(),
+            );
         closest.iter().filter(|&&d| d <= near).count()
     }
 
@@ -234,6 +244,7 @@ impl<const N: usize> Grid<N> {
         let counts = self.corner_counts();
         let total: usize = counts.iter().product();
         (0..total)
+            .into_par_iter()
             .map(|i| {
                 let idx = unflatten(i, &counts);
                 let p =
@@ -317,6 +328,7 @@ impl<const N: usize> Grid<N> {
     fn crossing_cells(&self, signs: &[bool]) -> Vec<bool> {
         let corners = self.corner_counts();
         (0..self.cell_count())
+            .into_par_iter()
             .map(|cell| {
                 let idx = unflatten(cell, &self.counts);
                 let mut seen = [false; 2];
