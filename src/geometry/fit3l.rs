@@ -242,8 +242,9 @@ pub fn fit_ip<const N: usize>(
                 .collect::<Vec<f64>>(),
         ),
     };
-    let mut best: Option<Fitted<N>> = None;
-    for offsets in &offset_sets[..candidates.len()] {
+    // The candidates on both cores as well as within each: their sequential parts (the zero set's samples, the
+    // solve's last steps) then overlap. The best is chosen in the candidates' order, as one after another would.
+    let fit_candidate = |offsets: &Vec<Offsets>| -> Result<Fitted<N>, FitError> {
         let (coeffs, condition_number) = solve_three_level(
             &monomials,
             &data_rows,
@@ -293,20 +294,28 @@ pub fn fit_ip<const N: usize>(
         stats.refinement_iterations = refinement_iterations;
         stats.side_segments = probes.len();
         stats.side_segments_crossed_again = probes.crossed_again(&model.poly);
-        let candidate = Fitted {
+        Ok(Fitted {
             model,
             method: options.method,
             stats,
             domain,
-        };
-        if best
-            .as_ref()
-            .is_none_or(|b| candidate.stats.closer_than(&b.stats))
-        {
-            best = Some(candidate);
-        }
-    }
-    Ok(best.expect("at least one offset is tried"))
+        })
+    };
+    let fitted = offset_sets[..candidates.len()]
+        .par_iter()
+        .map(fit_candidate)
+        .collect::<Result<Vec<_>, _>>()?;
+    let best = fitted
+        .into_iter()
+        .reduce(|best, candidate| {
+            if candidate.stats.closer_than(&best.stats) {
+                candidate
+            } else {
+                best
+            }
+        })
+        .expect("at least one offset is tried");
+    Ok(best)
 }
 
 /// Rejects point sets that lie on a line (2-D) or a plane (3-D): their spread has a vanishing direction.
