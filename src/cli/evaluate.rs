@@ -30,7 +30,9 @@ pub struct EvaluateArgs {
     /// joined at sharp edges).
     #[arg(long)]
     model: PathBuf,
-    /// The measured section: CSV with header y,z, in mm.
+    /// The measured section: CSV with header y,z, in mm. A sharp end's tip is its farthest point here: a point file
+    /// does not say which points are contacts of the ball rolling round the edge, whose mean the station takes, so
+    /// a chord read offline may differ from the station's by the noise of one contact (microns).
     #[arg(long)]
     points: PathBuf,
     /// What the best fit may move before the form is judged.
