@@ -131,12 +131,16 @@ impl<'a, const N: usize> Side<'a, N> {
 mod tests {
     use super::*;
     use crate::geometry::nearest::PointIndex;
-    use nalgebra::Vector2;
+    use nalgebra::{Vector2, Vector3};
     use rand::seq::SliceRandom;
     use rand::{Rng, SeedableRng};
 
     /// The old path: the nearest data point of the offset point must be the point itself or 0.98 c away.
-    fn by_nearest(unit: &[Vector2<f64>], normals: &[Vector2<f64>], largest: f64) -> Vec<Offsets> {
+    fn by_nearest<const N: usize>(
+        unit: &[SVector<f64, N>],
+        normals: &[SVector<f64, N>],
+        largest: f64,
+    ) -> Vec<Offsets> {
         let index = PointIndex::new(unit);
         let safe = |i: usize, direction: f64| -> Option<f64> {
             let mut c = largest;
@@ -203,5 +207,36 @@ mod tests {
             // Many rungs were blocked by a point an earlier rung found: the path that remembers them was taken.
             assert!(halved_twice > 1_000, "{halved_twice} ladders halved twice");
         }
+    }
+
+    #[test]
+    fn offsets_match_the_nearest_point_rule_on_a_thin_noisy_shell() {
+        // 3-D: a flat spheroid (semi-axes 1, 1 and 0.05; its rim's radius of curvature 0.0025), 3 000 points
+        // spread by the golden angle with noise along the normal. Inside, the offsets must stop at the middle
+        // plane; every ladder must be the nearest-point rule's.
+        let n = 3_000;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let (mut unit, mut normals) = (Vec::new(), Vec::new());
+        for k in 0..n {
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+            let (ring, phi) = ((1.0 - z * z).sqrt(), golden * k as f64);
+            let on = Vector3::new(ring * phi.cos(), ring * phi.sin(), 0.05 * z);
+            let normal = Vector3::new(on.x, on.y, on.z / 0.0025).normalize();
+            unit.push(on + normal * rng.gen_range(-2e-4..2e-4));
+            normals.push(normal);
+        }
+        let largests = [0.003, 0.01, 0.03, 0.1];
+        let sets = choose_offsets(&BallIndex::new(&unit), &unit, &normals, &largests);
+        let mut shrunk = 0;
+        for (fast, largest) in sets.iter().zip(largests) {
+            assert_eq!(
+                fast,
+                &by_nearest(&unit, &normals, largest),
+                "largest {largest}"
+            );
+            shrunk += fast.iter().filter(|o| o.inside != Some(largest)).count();
+        }
+        assert!(shrunk > n, "{shrunk} inside offsets shrink");
     }
 }
