@@ -11,7 +11,7 @@ use super::{all_rows, MethodArg};
 use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::held_out::{choose_degree, degrees_to_try, profile_scores};
+use crate::geometry::held_out::{choose_degree, combined_scores, degrees_to_try, profile_scores};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
 use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
@@ -23,8 +23,8 @@ pub struct FitIpArgs {
     #[arg(long)]
     points: PathBuf,
     /// Degree of the polynomial (of each profile, for a stack; of each face, for a profile with sharp edges), 1 to
-    /// 16. By default a profile's (or each face's) is chosen from 4, 6 and 8 by the points held out of its fit; a
-    /// stack's profiles and a surface are fitted at 4.
+    /// 16. By default a profile's (or each face's) is chosen from 4, 6 and 8 by the points held out of its fit, a
+    /// stack's (one for all its profiles) by the points held out of all of them; a surface is fitted at 4.
     #[arg(long, value_parser = degree)]
     degree: Option<usize>,
     /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
@@ -264,18 +264,12 @@ fn one_polynomial(
             let scores = profile_scores(points, &normals, method);
             let chosen = choose_degree(&scores);
             let first = fit(chosen)?;
-            let clean = |f: &Fitted<2>| {
-                let s = &f.stats;
-                s.branches_beside_data == 0
-                    && s.side_segments_crossed_again == 0
-                    && s.points_without_foot == 0
-            };
-            let fitted = if clean(&first) {
+            let fitted = if is_clean(&first) {
                 first
             } else {
                 degrees_to_try(chosen, &scores)[1..]
                     .iter()
-                    .find_map(|&degree| fit(degree).ok().filter(clean))
+                    .find_map(|&degree| fit(degree).ok().filter(is_clean))
                     .unwrap_or(first)
             };
             (fitted, scores, chosen)
@@ -283,10 +277,6 @@ fn one_polynomial(
     };
     print_fit(path, "profile", &fitted, points, args.tolerance)?;
     if !scores.is_empty() {
-        let scores: Vec<String> = scores
-            .iter()
-            .map(|(d, rms)| format!("{d}: {:.2} um", rms * 1000.0))
-            .collect();
         let degree = fitted.model.degree();
         let why = if degree == chosen {
             "chosen by".to_string()
@@ -298,7 +288,7 @@ fn one_polynomial(
         };
         reportln!(
             "  degree {degree} {why} the RMS distance of the points held out of the fit ({}); --degree gives one",
-            scores.join(", ")
+            held_out_list(&scores)
         )?;
     }
     Ok((
@@ -350,17 +340,10 @@ fn profile_normals(
     })
 }
 
-/// A stack's profile at one x, fitted at the stack's degree.
-fn fit_profile(
-    path: &Path,
-    points: &[Vector2<f64>],
-    options: &FitOptions,
-    normals: NormalsArg,
-) -> anyhow::Result<Fitted<2>> {
-    let normals = profile_normals(path, points, normals)?;
-    fit_ip(points, &normals, options).map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
-}
-
+/// A stack: one polynomial per plane of constant x, every one at the same degree (profiles blend only at equal
+/// degrees). The degree is `--degree`'s, or else the one of 4, 6 and 8 that the points held out of the profiles'
+/// fits choose together; where a profile's fit at it fails or has a defect the statistics show, the next best by
+/// held-out RMS at which every profile fits cleanly.
 fn fit_stack(
     path: &Path,
     points: &[Vector3<f64>],
@@ -379,21 +362,94 @@ fn fit_stack(
     let mut profiles = Vec::with_capacity(planes.len());
     for (x, plane) in planes {
         let yz: Vec<Vector2<f64>> = plane.iter().map(|p| Vector2::new(p.y, p.z)).collect();
-        let fitted = fit_profile(path, &yz, options, args.normals)
+        let normals = profile_normals(path, &yz, args.normals)
             .with_context(|| format!("the profile at x = {x:.3} mm"))?;
-        print_fit(
-            path,
-            &format!("profile at x = {x:.3} mm"),
-            &fitted,
-            &yz,
-            args.tolerance,
-        )?;
-        profiles.push(StackProfile {
-            x,
-            fitted: FittedIp::from(fitted),
-        });
+        profiles.push((x, yz, normals));
     }
-    Ok(profiles)
+    let fit_at = |degree: usize| -> anyhow::Result<Vec<Fitted<2>>> {
+        let options = FitOptions { degree, ..*options };
+        profiles
+            .iter()
+            .map(|(x, yz, normals)| {
+                fit_ip(yz, normals, &options)
+                    .map_err(|e| anyhow!("{}: {e}", all_rows(path, yz.len())))
+                    .with_context(|| format!("the profile at x = {x:.3} mm"))
+            })
+            .collect()
+    };
+    let (fits, scores, chosen) = match args.degree {
+        Some(degree) => (fit_at(degree)?, Vec::new(), degree),
+        None => {
+            let each: Vec<(usize, Vec<(usize, f64)>)> = profiles
+                .iter()
+                .map(|(_, yz, normals)| (yz.len() / 2, profile_scores(yz, normals, options.method)))
+                .collect();
+            let scores = combined_scores(&each);
+            let chosen = choose_degree(&scores);
+            let clean = |fits: &Vec<Fitted<2>>| fits.iter().all(is_clean);
+            let first = fit_at(chosen);
+            let fits = match first {
+                Ok(fits) if clean(&fits) => fits,
+                first => match degrees_to_try(chosen, &scores)[1..]
+                    .iter()
+                    .find_map(|&degree| fit_at(degree).ok().filter(clean))
+                {
+                    Some(fits) => fits,
+                    None => first?,
+                },
+            };
+            (fits, scores, chosen)
+        }
+    };
+    if !scores.is_empty() {
+        let degree = fits[0].model.degree();
+        let why = if degree == chosen {
+            "chosen by".to_string()
+        } else {
+            format!(
+                "taken because at degree {chosen}, chosen by the points held out, a profile fails or fits with a \
+                 spurious branch, sliver or footless point; see"
+            )
+        };
+        reportln!(
+            "stack degree {degree} {why} the RMS distance of the points held out of its profiles' fits ({}); \
+             --degree gives one",
+            held_out_list(&scores)
+        )?;
+    }
+    profiles
+        .iter()
+        .zip(fits)
+        .map(|((x, yz, _), fitted)| {
+            print_fit(
+                path,
+                &format!("profile at x = {x:.3} mm"),
+                &fitted,
+                yz,
+                args.tolerance,
+            )?;
+            Ok(StackProfile {
+                x: *x,
+                fitted: FittedIp::from(fitted),
+            })
+        })
+        .collect()
+}
+
+/// Whether a fit has none of the defects its statistics show: a spurious branch or sliver beside the data, or a
+/// point with no foot.
+fn is_clean(fitted: &Fitted<2>) -> bool {
+    let s = &fitted.stats;
+    s.branches_beside_data == 0 && s.side_segments_crossed_again == 0 && s.points_without_foot == 0
+}
+
+/// Held-out scores as printed: "4: 2.10 um, 6: ...".
+fn held_out_list(scores: &[(usize, f64)]) -> String {
+    scores
+        .iter()
+        .map(|(d, rms)| format!("{d}: {:.2} um", rms * 1000.0))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Splits points into planes of (nearly) constant x, keeping file order within each plane.

@@ -73,6 +73,26 @@ pub(crate) fn profile_scores(
         .collect()
 }
 
+/// The held-out RMS (mm) of each degree over several profiles fitted at one degree (a stack's: its profiles blend
+/// only at equal degrees), from each profile's points held out and [`profile_scores`]: the root of the mean
+/// square over every held-out point, so each profile weighs by its points. A degree that some profile could not
+/// be fitted at is left out.
+pub(crate) fn combined_scores(profiles: &[(usize, Vec<(usize, f64)>)]) -> Vec<(usize, f64)> {
+    CANDIDATE_DEGREES
+        .into_iter()
+        .filter_map(|degree| {
+            let (squares, points) =
+                profiles
+                    .iter()
+                    .try_fold((0.0, 0usize), |(squares, points), (count, scores)| {
+                        let rms = scores.iter().find(|s| s.0 == degree)?.1;
+                        Some((squares + rms * rms * *count as f64, points + count))
+                    })?;
+            (points > 0).then(|| (degree, (squares / points as f64).sqrt()))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,6 +120,22 @@ mod tests {
         assert_eq!(choose_degree(&scores), 6);
         assert_eq!(degrees_to_try(6, &scores), vec![6, 8, 4]);
         assert_eq!(degrees_to_try(4, &[]), vec![4]);
+    }
+
+    #[test]
+    fn a_stack_s_scores_weigh_each_profile_by_its_points_and_drop_a_degree_one_profile_lacks() {
+        // 100 held-out points at 3 um and 300 at 1 um: sqrt((100 * 9 + 300 * 1) / 400) = sqrt(3) um at degree 4.
+        let profiles = [
+            (100, vec![(4, 0.003), (6, 0.002), (8, 0.002)]),
+            (300, vec![(4, 0.001), (6, 0.001)]),
+        ];
+        let combined = combined_scores(&profiles);
+        assert_eq!(combined.len(), 2, "degree 8 is missing from one profile");
+        assert_eq!(combined[0].0, 4);
+        assert!((combined[0].1 - 3f64.sqrt() * 1e-3).abs() < 1e-15);
+        assert_eq!(combined[1].0, 6);
+        assert!((combined[1].1 - 1.75f64.sqrt() * 1e-3).abs() < 1e-15);
+        assert!(combined_scores(&[]).is_empty());
     }
 
     #[test]

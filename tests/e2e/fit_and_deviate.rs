@@ -227,6 +227,70 @@ pub fn ellipsoid_csv(path: &std::path::Path, count: usize, offset: f64) {
 }
 
 #[test]
+fn a_stack_without_a_degree_takes_the_one_the_points_held_out_of_all_its_profiles_choose() {
+    // The blade's NACA profiles have sharp trailing edges, which no quartic follows: the points held out of the
+    // five profiles' fits choose a higher degree, one for all of them (profiles blend only at equal degrees).
+    let dir = tempfile::tempdir().unwrap();
+    let points = config("profiles/naca-blade-a-5-profiles.csv");
+    let (fit, saved) = fit_ip(&points, &["--stack"], &dir.path().join("stack.json"));
+    // "stack degree D chosen by the RMS distance ... (4: a um, 6: b um, 8: c um); --degree gives one"
+    let line = fit
+        .lines()
+        .find(|l| l.starts_with("stack degree "))
+        .unwrap_or_else(|| panic!("no stack degree said: {fit}"));
+    let degree: usize = line["stack degree ".len()..]
+        .split(' ')
+        .next()
+        .and_then(|d| d.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    let scores: Vec<(usize, f64)> = line[line.find('(').unwrap() + 1..line.find(')').unwrap()]
+        .split(", ")
+        .map(|score| {
+            let (d, rms) = score.split_once(": ").unwrap();
+            (
+                d.parse().unwrap(),
+                rms.trim_end_matches(" um").parse().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        scores.iter().map(|s| s.0).collect::<Vec<_>>(),
+        vec![4, 6, 8],
+        "{line}"
+    );
+    // From the lowest up, a higher degree replaces the one chosen so far only by beating its held-out RMS by 10%.
+    let mut expected = scores[0];
+    for &score in &scores[1..] {
+        if score.1 < 0.9 * expected.1 {
+            expected = score;
+        }
+    }
+    assert!(
+        degree == expected.0 && line.contains(" chosen by "),
+        "{line}"
+    );
+    assert!(
+        degree > 4 && scores[0].1 > 2.0 * expected.1,
+        "a quartic should not follow the sharp edges: {line}"
+    );
+    assert_eq!(
+        fit.matches(&format!(
+            "fitted a degree-{degree} implicit polynomial (profile at x"
+        ))
+        .count(),
+        5,
+        "{fit}"
+    );
+    let degrees: Vec<u64> = saved["model"]["profiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["ip"]["poly"]["degree"].as_u64().unwrap())
+        .collect();
+    assert_eq!(degrees, vec![degree as u64; 5]);
+}
+
+#[test]
 fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
     let dir = tempfile::tempdir().unwrap();
     let master = dir.path().join("master.csv");
