@@ -137,8 +137,22 @@ async fn an_abort_mid_scan_ends_the_stream_and_locks_out_motion_until_cleared() 
         "{refused}"
     );
     client.clear_all_errors().await.expect("ClearAllErrors");
+    // Where the probe stopped depends on how many points the simulator scanned before the abort reached it (more
+    // on a loaded machine), and the ball stands on the section there. A straight move above the blade can cross
+    // the section from its underside (the simulator rightly refuses it as a collision): the move that is safe
+    // from any stop is away from the section, along its normal at the nearest point.
+    let stopped = client.position().await.expect("the probe's position");
+    let truth = propeller();
+    let frame = truth.section_frame(0, 200.0);
+    let at = frame.local(&Point3::new(stopped.x, stopped.y, stopped.z));
+    let nearest = SampledCurve::new(truth.section_curve(0, 200.0))
+        .nearest(&Point2::new(at.x, at.y))
+        .on_curve
+        .point;
+    let away = Vector3::new(at.x - nearest.x, at.y - nearest.y, 0.0).normalize() * 2.0;
+    let clear = frame.world(at.x + away.x, at.y + away.y, at.z);
     client
-        .go_to(Xyz::new(200.0, top.y, top.z + 30.0))
+        .go_to(xyz(&clear))
         .await
         .expect("motion after the clear");
 }
