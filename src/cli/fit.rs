@@ -11,7 +11,9 @@ use super::{all_rows, MethodArg};
 use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
-use crate::geometry::held_out::{choose_degree, combined_scores, degrees_to_try, profile_scores};
+use crate::geometry::held_out::{
+    choose_degree, clean_fit_or_chosen, combined_scores, profile_scores,
+};
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
 use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
@@ -263,15 +265,7 @@ fn one_polynomial(
         None => {
             let scores = profile_scores(points, &normals, method);
             let chosen = choose_degree(&scores);
-            let first = fit(chosen)?;
-            let fitted = if is_clean(&first) {
-                first
-            } else {
-                degrees_to_try(chosen, &scores)[1..]
-                    .iter()
-                    .find_map(|&degree| fit(degree).ok().filter(is_clean))
-                    .unwrap_or(first)
-            };
+            let fitted = clean_fit_or_chosen(chosen, &scores, fit, is_clean)?;
             (fitted, scores, chosen)
         }
     };
@@ -386,18 +380,9 @@ fn fit_stack(
                 .collect();
             let scores = combined_scores(&each);
             let chosen = choose_degree(&scores);
-            let clean = |fits: &Vec<Fitted<2>>| fits.iter().all(is_clean);
-            let first = fit_at(chosen);
-            let fits = match first {
-                Ok(fits) if clean(&fits) => fits,
-                first => match degrees_to_try(chosen, &scores)[1..]
-                    .iter()
-                    .find_map(|&degree| fit_at(degree).ok().filter(clean))
-                {
-                    Some(fits) => fits,
-                    None => first?,
-                },
-            };
+            let fits = clean_fit_or_chosen(chosen, &scores, fit_at, |fits: &Vec<Fitted<2>>| {
+                fits.iter().all(is_clean)
+            })?;
             (fits, scores, chosen)
         }
     };

@@ -39,6 +39,25 @@ pub(crate) fn degrees_to_try(chosen: usize, scores: &[(usize, f64)]) -> Vec<usiz
         .collect()
 }
 
+/// The fit to keep once a degree is chosen: the chosen degree's where it is `clean` (none of the defects a fit's
+/// statistics show), else the first clean one of the other degrees, best held-out first; where none is, the chosen
+/// degree's own result (its fit, whose defects its statistics report, or its error).
+pub(crate) fn clean_fit_or_chosen<T, E>(
+    chosen: usize,
+    scores: &[(usize, f64)],
+    mut fit: impl FnMut(usize) -> Result<T, E>,
+    clean: impl Fn(&T) -> bool,
+) -> Result<T, E> {
+    let first = fit(chosen);
+    if first.as_ref().is_ok_and(&clean) {
+        return first;
+    }
+    degrees_to_try(chosen, scores)[1..]
+        .iter()
+        .find_map(|&degree| fit(degree).ok().filter(&clean))
+        .map_or(first, Ok)
+}
+
 /// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
 /// the model, where the first-order distance is exact to second order.
 pub(crate) fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
@@ -120,6 +139,38 @@ mod tests {
         assert_eq!(choose_degree(&scores), 6);
         assert_eq!(degrees_to_try(6, &scores), vec![6, 8, 4]);
         assert_eq!(degrees_to_try(4, &[]), vec![4]);
+    }
+
+    #[test]
+    fn the_chosen_degree_is_kept_where_clean_else_the_best_clean_other_else_its_own_result() {
+        let scores = [(4, 0.005), (6, 0.002), (8, 0.003)];
+        // A fit stands for its degree; `clean` and the errors are given per degree.
+        let keep = |clean: &[usize], failing: &[usize]| {
+            let mut tried = Vec::new();
+            let kept = clean_fit_or_chosen(
+                6,
+                &scores,
+                |degree| {
+                    tried.push(degree);
+                    if failing.contains(&degree) {
+                        Err(degree)
+                    } else {
+                        Ok(degree)
+                    }
+                },
+                |degree| clean.contains(degree),
+            );
+            (kept, tried)
+        };
+        assert_eq!(keep(&[4, 6, 8], &[]), (Ok(6), vec![6]));
+        // Unclean: the others best held-out first (8 before 4), the first clean one kept.
+        assert_eq!(keep(&[4, 8], &[]), (Ok(8), vec![6, 8]));
+        assert_eq!(keep(&[4], &[8]), (Ok(4), vec![6, 8, 4]));
+        // The chosen one failing does not end the search.
+        assert_eq!(keep(&[4], &[6]), (Ok(4), vec![6, 8, 4]));
+        // No degree clean: the chosen one's fit, or its error.
+        assert_eq!(keep(&[], &[]), (Ok(6), vec![6, 8, 4]));
+        assert_eq!(keep(&[], &[6]), (Err(6), vec![6, 8, 4]));
     }
 
     #[test]
