@@ -162,6 +162,24 @@ mod tests {
             .collect()
     }
 
+    /// The offsets of every ladder a 3L fit climbs, computed together, each asserted to be the nearest-point
+    /// rule's; with their largest offsets.
+    fn every_ladder_by_the_nearest_point_rule<const N: usize>(
+        unit: &[SVector<f64, N>],
+        normals: &[SVector<f64, N>],
+    ) -> Vec<(Vec<Offsets>, f64)> {
+        let largests = [0.003, 0.01, 0.03, 0.1];
+        let sets = choose_offsets(&BallIndex::new(unit), unit, normals, &largests);
+        for (fast, largest) in sets.iter().zip(largests) {
+            assert_eq!(
+                fast,
+                &by_nearest(unit, normals, largest),
+                "largest {largest}"
+            );
+        }
+        sets.into_iter().zip(largests).collect()
+    }
+
     #[test]
     fn offsets_match_the_nearest_point_rule_on_a_thin_noisy_section_in_any_order() {
         // A thin lens (1 by 0.02 at the middle, sharp at both ends), 2 000 points with noise along the normal (so
@@ -183,19 +201,11 @@ mod tests {
         normals.extend_from_within(0..10);
         let mut shuffled: Vec<usize> = (0..unit.len()).collect();
         shuffled.shuffle(&mut rng);
-        let largests = [0.003, 0.01, 0.03, 0.1];
         for order in [(0..unit.len()).collect(), shuffled] {
             let unit: Vec<Vector2<f64>> = order.iter().map(|&i| unit[i]).collect();
             let normals: Vec<Vector2<f64>> = order.iter().map(|&i| normals[i]).collect();
-            let index = BallIndex::new(&unit);
-            let sets = choose_offsets(&index, &unit, &normals, &largests);
             let mut halved_twice = 0;
-            for (fast, largest) in sets.iter().zip(largests) {
-                assert_eq!(
-                    fast,
-                    &by_nearest(&unit, &normals, largest),
-                    "largest {largest}"
-                );
+            for (fast, largest) in every_ladder_by_the_nearest_point_rule(&unit, &normals) {
                 let shrunk = fast.iter().filter(|o| o.inside != Some(largest)).count();
                 assert!(shrunk > 0, "some inside offsets shrink at {largest}");
                 halved_twice += fast
@@ -226,15 +236,8 @@ mod tests {
             unit.push(on + normal * rng.gen_range(-2e-4..2e-4));
             normals.push(normal);
         }
-        let largests = [0.003, 0.01, 0.03, 0.1];
-        let sets = choose_offsets(&BallIndex::new(&unit), &unit, &normals, &largests);
         let mut shrunk = 0;
-        for (fast, largest) in sets.iter().zip(largests) {
-            assert_eq!(
-                fast,
-                &by_nearest(&unit, &normals, largest),
-                "largest {largest}"
-            );
+        for (fast, largest) in every_ladder_by_the_nearest_point_rule(&unit, &normals) {
             shrunk += fast.iter().filter(|o| o.inside != Some(largest)).count();
         }
         assert!(shrunk > n, "{shrunk} inside offsets shrink");
