@@ -12,8 +12,13 @@ use super::small;
 /// Neighbours used for local PCA: enough to average out 2 um probe noise without smoothing over a trailing edge.
 const PCA_NEIGHBOURS: usize = 10;
 
-/// Normals of an ordered, closed profile: perpendicular to the central-difference tangent, pointing away from the
-/// enclosed area whichever way the profile runs. Needs at least three points.
+/// A profile whose last point lies farther than this many median steps from its first is an open arc (a scan of
+/// part of a section): its end points have no neighbour across the gap.
+const OPEN_ARC_GAP_STEPS: f64 = 3.0;
+
+/// Normals of an ordered profile: perpendicular to the central-difference tangent, pointing away from the enclosed
+/// area (for an open arc, the area its chord between the ends closes) whichever way the profile runs. The ends of
+/// an open arc take the one-sided tangent. Needs at least three points.
 pub fn ordered_profile_normals(points: &[Vector2<f64>]) -> Vec<Vector2<f64>> {
     let n = points.len();
     let twice_area: f64 = (0..n)
@@ -24,13 +29,32 @@ pub fn ordered_profile_normals(points: &[Vector2<f64>]) -> Vec<Vector2<f64>> {
         .sum();
     // Counter-clockwise profiles have their outside on the right of the direction of travel.
     let outward_sign = if twice_area >= 0.0 { 1.0 } else { -1.0 };
+    let open = is_open_arc(points);
     (0..n)
         .map(|i| {
-            let tangent = points[(i + 1) % n] - points[(i + n - 1) % n];
+            let before = if open && i == 0 { 0 } else { (i + n - 1) % n };
+            let after = if open && i == n - 1 {
+                n - 1
+            } else {
+                (i + 1) % n
+            };
+            let tangent = points[after] - points[before];
             let normal = Vector2::new(tangent.y, -tangent.x) * outward_sign;
             normal.try_normalize(0.0).unwrap_or_else(Vector2::x)
         })
         .collect()
+}
+
+/// Whether the gap from the last point back to the first is several times the profile's median step.
+fn is_open_arc(points: &[Vector2<f64>]) -> bool {
+    let n = points.len();
+    if n < 3 {
+        return false;
+    }
+    let mut steps: Vec<f64> = points.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let middle = steps.len() / 2;
+    let median = *steps.select_nth_unstable_by(middle, f64::total_cmp).1;
+    (points[n - 1] - points[0]).norm() > OPEN_ARC_GAP_STEPS * median
 }
 
 /// Normals of unordered points by local PCA (the direction of least spread among the nearest neighbours),
@@ -167,6 +191,29 @@ mod tests {
                 assert!(
                     n.dot(&radial) > 0.999,
                     "clockwise={clockwise}: {n} vs {radial}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_open_arc_s_ends_take_their_own_tangent_not_the_gap_s() {
+        // Two thirds of the circle, either way round: across the gap from the last point to the first, a
+        // central difference would turn the end normals by 60 deg.
+        for clockwise in [false, true] {
+            let arc = &circle(60, clockwise)[..40];
+            let normals = ordered_profile_normals(arc);
+            for (i, (p, n)) in arc.iter().zip(&normals).enumerate() {
+                let radial = (p - Vector2::new(3.0, -1.0)).normalize();
+                let tolerance = if i == 0 || i == arc.len() - 1 {
+                    // one-sided: the chord's normal lies half a step's turn (3 deg) off the radius
+                    0.998
+                } else {
+                    0.999
+                };
+                assert!(
+                    n.dot(&radial) > tolerance,
+                    "clockwise={clockwise}, point {i}: {n} vs {radial}"
                 );
             }
         }
