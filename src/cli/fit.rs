@@ -3,11 +3,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, bail, Context};
+use anyhow::{anyhow, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::{SVector, Vector2, Vector3};
 
-use super::{all_rows, MethodArg};
+use super::{rows_of, MethodArg};
 use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
@@ -102,14 +102,15 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let file = read_point_file(&args.points)?;
     warn_of_isolated_points(&file)?;
     let options = FitOptions::new(args.degree.unwrap_or(DEFAULT_DEGREE), args.method.into());
+    let lines = &file.lines;
     let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
             match fit_faces_of(args, &points)? {
                 Some(faced) => (ReferenceModel::Faces(faced), options.method),
-                None => one_polynomial(args, &points)?,
+                None => one_polynomial(args, &points, lines)?,
             }
         }
-        (PointSet::Profile(points), false) => one_polynomial(args, &points)?,
+        (PointSet::Profile(points), false) => one_polynomial(args, &points, lines)?,
         (PointSet::Spatial(points), false) => {
             if args.normals == NormalsArg::Ordered {
                 bail!(
@@ -119,7 +120,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             }
             let normals = pca_normals(&points);
             let fitted = fit_ip(&points, &normals, &options)
-                .map_err(|e| anyhow!("{}: {e}", all_rows(&args.points, points.len())))?;
+                .map_err(|e| anyhow!("{}: {e}", rows_of(&args.points, lines, 0..points.len())))?;
             print_fit(&args.points, "surface", &fitted, &points, args.tolerance)?;
             warn_if_profiles(&points, args.plane_tolerance)?;
             (
@@ -128,7 +129,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             )
         }
         (PointSet::Spatial(points), true) => {
-            let profiles = fit_stack(&args.points, &points, &options, args)?;
+            let profiles = fit_stack(&args.points, &points, lines, &options, args)?;
             (ReferenceModel::Stack { profiles }, options.method)
         }
         (PointSet::Profile(_), true) => {
@@ -252,33 +253,48 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
 fn one_polynomial(
     args: &FitIpArgs,
     points: &[Vector2<f64>],
+    lines: &[u64],
 ) -> anyhow::Result<(ReferenceModel, FitMethod)> {
     let path = &args.points;
-    let normals = profile_normals(path, points, args.normals)?;
+    let rows = || rows_of(path, lines, 0..points.len());
+    let normals = profile_normals(points, args.normals).map_err(|e| anyhow!("{}: {e}", rows()))?;
     let method: FitMethod = args.method.into();
     let fit = |degree: usize| {
         fit_ip(points, &normals, &FitOptions::new(degree, method))
-            .map_err(|e| anyhow!("{}: {e}", all_rows(path, points.len())))
+            .map_err(|e| anyhow!("{}: {e}", rows()))
     };
-    let (fitted, scores, chosen) = match args.degree {
-        Some(degree) => (fit(degree)?, Vec::new(), degree),
+    let (fitted, scores, chosen, passed_over) = match args.degree {
+        Some(degree) => (fit(degree)?, Vec::new(), degree, None),
         None => {
             let scores = profile_scores(points, &normals, method);
             let chosen = choose_degree(&scores);
-            let fitted = clean_fit_or_chosen(chosen, &scores, fit, is_clean)?;
-            (fitted, scores, chosen)
+            let mut passed_over = None;
+            let fitted = clean_fit_or_chosen(
+                chosen,
+                &scores,
+                |degree| {
+                    let result = fit(degree);
+                    if degree == chosen {
+                        passed_over = match &result {
+                            Ok(fitted) => defects(fitted).map(|d| format!("fits with {d}")),
+                            Err(e) => Some(format!("fails ({e:#})")),
+                        };
+                    }
+                    result
+                },
+                |fitted| defects(fitted).is_none(),
+            )?;
+            (fitted, scores, chosen, passed_over)
         }
     };
     print_fit(path, "profile", &fitted, points, args.tolerance)?;
     if !scores.is_empty() {
         let degree = fitted.model.degree();
-        let why = if degree == chosen {
-            "chosen by".to_string()
-        } else {
-            format!(
-                "taken because degree {chosen}, chosen by the points held out, fits with a spurious branch, sliver \
-                 or footless point; see"
-            )
+        let why = match passed_over.filter(|_| degree != chosen) {
+            None => "chosen by".to_string(),
+            Some(problem) => format!(
+                "taken because degree {chosen}, chosen by the points held out, {problem}; see"
+            ),
         };
         reportln!(
             "  degree {degree} {why} the RMS distance of the points held out of the fit ({}); --degree gives one",
@@ -309,18 +325,13 @@ fn runs_along_the_profile<const N: usize>(points: &[SVector<f64, N>]) -> bool {
     in_order as f64 >= 0.95 * n as f64
 }
 
-/// The outward normals of a profile's points, for its 3L offsets.
+/// The outward normals of a profile's points, for its 3L offsets. The caller names the points' rows in an error.
 fn profile_normals(
-    path: &Path,
     points: &[Vector2<f64>],
     normals: NormalsArg,
 ) -> anyhow::Result<Vec<Vector2<f64>>> {
     if points.len() < 3 {
-        bail!(
-            "{}: {} points are too few for a profile",
-            all_rows(path, points.len()),
-            points.len()
-        );
+        bail!("{} points are too few for a profile", points.len());
     }
     let ordered = match normals {
         NormalsArg::Ordered => true,
@@ -337,10 +348,11 @@ fn profile_normals(
 /// A stack: one polynomial per plane of constant x, every one at the same degree (profiles blend only at equal
 /// degrees). The degree is `--degree`'s, or else the one of 4, 6 and 8 that the points held out of the profiles'
 /// fits choose together; where a profile's fit at it fails or has a defect the statistics show, the next best by
-/// held-out RMS at which every profile fits cleanly.
+/// held-out RMS at which every profile fits cleanly. Errors name the profile and its own lines in the file.
 fn fit_stack(
     path: &Path,
     points: &[Vector3<f64>],
+    lines: &[u64],
     options: &FitOptions,
     args: &FitIpArgs,
 ) -> anyhow::Result<Vec<StackProfile>> {
@@ -348,53 +360,79 @@ fn fit_stack(
     if planes.len() < 2 {
         bail!(
             "{}: the points lie in {} plane(s) of constant x (tolerance {} mm); a stack needs at least two",
-            all_rows(path, points.len()),
+            rows_of(path, lines, 0..points.len()),
             planes.len(),
             args.plane_tolerance
         );
     }
     let mut profiles = Vec::with_capacity(planes.len());
-    for (x, plane) in planes {
-        let yz: Vec<Vector2<f64>> = plane.iter().map(|p| Vector2::new(p.y, p.z)).collect();
-        let normals = profile_normals(path, &yz, args.normals)
-            .with_context(|| format!("the profile at x = {x:.3} mm"))?;
-        profiles.push((x, yz, normals));
+    for (x, indices) in planes {
+        let yz: Vec<Vector2<f64>> = indices
+            .iter()
+            .map(|&i| Vector2::new(points[i].y, points[i].z))
+            .collect();
+        let rows = rows_of(path, lines, indices.iter().copied());
+        let normals = profile_normals(&yz, args.normals)
+            .map_err(|e| anyhow!("{rows}: the profile at x = {x:.3} mm: {e}"))?;
+        profiles.push((x, yz, normals, rows));
     }
     let fit_at = |degree: usize| -> anyhow::Result<Vec<Fitted<2>>> {
         let options = FitOptions { degree, ..*options };
         profiles
             .iter()
-            .map(|(x, yz, normals)| {
+            .map(|(x, yz, normals, rows)| {
                 fit_ip(yz, normals, &options)
-                    .map_err(|e| anyhow!("{}: {e}", all_rows(path, yz.len())))
-                    .with_context(|| format!("the profile at x = {x:.3} mm"))
+                    .map_err(|e| anyhow!("{rows}: the profile at x = {x:.3} mm: {e}"))
             })
             .collect()
     };
-    let (fits, scores, chosen) = match args.degree {
-        Some(degree) => (fit_at(degree)?, Vec::new(), degree),
+    let (fits, scores, chosen, passed_over) = match args.degree {
+        Some(degree) => (fit_at(degree)?, Vec::new(), degree, None),
         None => {
             let each: Vec<(usize, Vec<(usize, f64)>)> = profiles
                 .iter()
-                .map(|(_, yz, normals)| (yz.len() / 2, profile_scores(yz, normals, options.method)))
+                .map(|(_, yz, normals, _)| {
+                    (yz.len() / 2, profile_scores(yz, normals, options.method))
+                })
                 .collect();
             let scores = combined_scores(&each);
             let chosen = choose_degree(&scores);
-            let fits = clean_fit_or_chosen(chosen, &scores, fit_at, |fits: &Vec<Fitted<2>>| {
-                fits.iter().all(is_clean)
-            })?;
-            (fits, scores, chosen)
+            let mut passed_over = None;
+            let fits = clean_fit_or_chosen(
+                chosen,
+                &scores,
+                |degree| {
+                    let result = fit_at(degree);
+                    if degree == chosen {
+                        passed_over = Some(match &result {
+                            Ok(fits) => profiles
+                                .iter()
+                                .zip(fits)
+                                .filter_map(|((x, ..), fitted)| {
+                                    let defects = defects(fitted)?;
+                                    Some(format!(
+                                        "the profile at x = {x:.3} mm fits with {defects}"
+                                    ))
+                                })
+                                .collect::<Vec<_>>()
+                                .join("; "),
+                            Err(e) => format!("{e:#}"),
+                        });
+                    }
+                    result
+                },
+                |fits: &Vec<Fitted<2>>| fits.iter().all(|f| defects(f).is_none()),
+            )?;
+            (fits, scores, chosen, passed_over)
         }
     };
     if !scores.is_empty() {
         let degree = fits[0].model.degree();
-        let why = if degree == chosen {
-            "chosen by".to_string()
-        } else {
-            format!(
-                "taken because at degree {chosen}, chosen by the points held out, a profile fails or fits with a \
-                 spurious branch, sliver or footless point; see"
-            )
+        let why = match passed_over.filter(|_| degree != chosen) {
+            None => "chosen by".to_string(),
+            Some(problem) => format!(
+                "taken because at degree {chosen}, chosen by the points held out, {problem}; see"
+            ),
         };
         reportln!(
             "stack degree {degree} {why} the RMS distance of the points held out of its profiles' fits ({}); \
@@ -405,7 +443,7 @@ fn fit_stack(
     profiles
         .iter()
         .zip(fits)
-        .map(|((x, yz, _), fitted)| {
+        .map(|((x, yz, ..), fitted)| {
             print_fit(
                 path,
                 &format!("profile at x = {x:.3} mm"),
@@ -421,11 +459,36 @@ fn fit_stack(
         .collect()
 }
 
-/// Whether a fit has none of the defects its statistics show: a spurious branch or sliver beside the data, or a
-/// point with no foot.
-fn is_clean(fitted: &Fitted<2>) -> bool {
+/// The defects a fit's statistics show, as a phrase ("2 spurious branches beside the data and 3 points with no
+/// foot"), or `None` for a clean fit: a spurious branch or sliver beside the data, or a point with no foot.
+fn defects(fitted: &Fitted<2>) -> Option<String> {
     let s = &fitted.stats;
-    s.branches_beside_data == 0 && s.side_segments_crossed_again == 0 && s.points_without_foot == 0
+    let count = |n: usize, one: &str, many: &str| match n {
+        0 => None,
+        1 => Some(format!("1 {one}")),
+        n => Some(format!("{n} {many}")),
+    };
+    let found: Vec<String> = [
+        count(
+            s.branches_beside_data,
+            "spurious branch beside the data",
+            "spurious branches beside the data",
+        ),
+        count(
+            s.side_segments_crossed_again,
+            "segment across the data crossed twice (a sliver)",
+            "segments across the data crossed twice (a sliver)",
+        ),
+        count(
+            s.points_without_foot,
+            "point with no foot",
+            "points with no foot",
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    (!found.is_empty()).then(|| found.join(" and "))
 }
 
 /// Held-out scores as printed: "4: 2.10 um, 6: ...".
@@ -437,8 +500,8 @@ fn held_out_list(scores: &[(usize, f64)]) -> String {
         .join(", ")
 }
 
-/// Splits points into planes of (nearly) constant x, keeping file order within each plane.
-fn group_into_planes(points: &[Vector3<f64>], tolerance: f64) -> Vec<(f64, Vec<Vector3<f64>>)> {
+/// Splits points into planes of (nearly) constant x: each plane's mean x and its points' indices, in file order.
+fn group_into_planes(points: &[Vector3<f64>], tolerance: f64) -> Vec<(f64, Vec<usize>)> {
     let mut xs: Vec<f64> = points.iter().map(|p| p.x).collect();
     xs.sort_by(f64::total_cmp);
     let mut centres: Vec<Vec<f64>> = Vec::new();
@@ -452,12 +515,10 @@ fn group_into_planes(points: &[Vector3<f64>], tolerance: f64) -> Vec<(f64, Vec<V
     bounds
         .iter()
         .map(|&(lo, hi)| {
-            let plane: Vec<Vector3<f64>> = points
-                .iter()
-                .copied()
-                .filter(|p| p.x >= lo && p.x <= hi)
+            let plane: Vec<usize> = (0..points.len())
+                .filter(|&i| points[i].x >= lo && points[i].x <= hi)
                 .collect();
-            let x = plane.iter().map(|p| p.x).sum::<f64>() / plane.len() as f64;
+            let x = plane.iter().map(|&i| points[i].x).sum::<f64>() / plane.len() as f64;
             (x, plane)
         })
         .collect()
@@ -555,3 +616,34 @@ fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) -> anyhow::Re
 
 /// A plane of constant x holding at least this many points is a scanned profile, not a scatter of surface points.
 const MIN_PROFILE_POINTS: usize = 10;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fit_s_defects_are_named_with_their_counts() {
+        let points: Vec<Vector2<f64>> = (0..40)
+            .map(|i| {
+                let t = i as f64 / 40.0 * std::f64::consts::TAU;
+                Vector2::new(10.0 * t.cos(), 5.0 * t.sin())
+            })
+            .collect();
+        let normals = ordered_profile_normals(&points);
+        let mut fitted = fit_ip(&points, &normals, &FitOptions::new(2, FitMethod::ThreeL)).unwrap();
+        assert_eq!(defects(&fitted), None, "an ellipse's conic is clean");
+        fitted.stats.branches_beside_data = 1;
+        fitted.stats.points_without_foot = 3;
+        assert_eq!(
+            defects(&fitted).as_deref(),
+            Some("1 spurious branch beside the data and 3 points with no foot")
+        );
+        fitted.stats.branches_beside_data = 0;
+        fitted.stats.points_without_foot = 0;
+        fitted.stats.side_segments_crossed_again = 2;
+        assert_eq!(
+            defects(&fitted).as_deref(),
+            Some("2 segments across the data crossed twice (a sliver)")
+        );
+    }
+}

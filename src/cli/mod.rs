@@ -181,7 +181,57 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     ran.and_then(|()| exit::report_cut_off())
 }
 
-/// "FILE: lines 2-N" for problems of a whole point set (the header is line 1).
-fn all_rows(path: &std::path::Path, count: usize) -> String {
-    format!("{}: lines 2-{}", path.display(), count + 1)
+/// "FILE: lines 402-801" for a problem of some of a point file's points: `indices` (ascending) into the file's
+/// points, `lines` each point's line in the file. Runs of consecutive points are named by their first and last
+/// lines, the first three runs and how many more.
+fn rows_of(
+    path: &std::path::Path,
+    lines: &[u64],
+    indices: impl IntoIterator<Item = usize>,
+) -> String {
+    const RUNS_NAMED: usize = 3;
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for i in indices {
+        match runs.last_mut() {
+            Some((_, last)) if *last + 1 == i => *last = i,
+            _ => runs.push((i, i)),
+        }
+    }
+    let mut named: Vec<String> = runs
+        .iter()
+        .take(RUNS_NAMED)
+        .map(|&(first, last)| match (lines[first], lines[last]) {
+            (a, b) if a == b => a.to_string(),
+            (a, b) => format!("{a}-{b}"),
+        })
+        .collect();
+    if runs.len() > RUNS_NAMED {
+        named.push(format!("and {} more runs", runs.len() - RUNS_NAMED));
+    }
+    let word = if runs.len() == 1 && runs[0].0 == runs[0].1 {
+        "line"
+    } else {
+        "lines"
+    };
+    format!("{}: {word} {}", path.display(), named.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rows_of;
+    use std::path::Path;
+
+    #[test]
+    fn rows_are_named_by_their_own_lines_run_by_run() {
+        let path = Path::new("stack.csv");
+        // A comment on line 5 moves every later point down a line.
+        let lines: Vec<u64> = (2..5).chain(6..12).collect();
+        assert_eq!(rows_of(path, &lines, 0..9), "stack.csv: lines 2-11");
+        assert_eq!(rows_of(path, &lines, 3..9), "stack.csv: lines 6-11");
+        assert_eq!(rows_of(path, &lines, [4]), "stack.csv: line 7");
+        assert_eq!(
+            rows_of(path, &lines, [0, 2, 3, 5, 7, 8]),
+            "stack.csv: lines 2, 4-6, 8, and 1 more runs"
+        );
+    }
 }

@@ -6,20 +6,28 @@ use crate::support::zeroset;
 
 /// Fits a point file with the given text and returns the single error line (asserting there is exactly one).
 fn fit_error(text: &str, degree: &str) -> String {
+    fit_error_with(text, &["--degree", degree])
+}
+
+/// As [`fit_error`], with these arguments after the point file's.
+fn fit_error_with(text: &str, args: &[&str]) -> String {
     let dir = tempfile::tempdir().unwrap();
     let points = dir.path().join("points.csv");
     std::fs::write(&points, text).unwrap();
     let out = dir.path().join("model.json");
-    let run = zeroset(&[
-        "fit",
-        "ip",
-        "--points",
-        points.to_str().unwrap(),
-        "--degree",
-        degree,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let run = zeroset(
+        &[
+            "fit",
+            "ip",
+            "--points",
+            points.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .into_iter()
+        .chain(args.iter().copied())
+        .collect::<Vec<_>>(),
+    );
     assert!(!run.success, "bad input must fail: {}", run.stdout);
     assert!(!out.exists(), "no model is written from bad input");
     let lines: Vec<&str> = run.stderr.lines().collect();
@@ -87,6 +95,23 @@ fn too_few_points_for_the_degree_says_how_many_are_needed() {
     assert_eq!(
         line,
         "error: DIR/points.csv: lines 2-13: 12 points are too few for a degree-4 fit (it has 15 coefficients; give at least 15 points)"
+    );
+}
+
+#[test]
+fn a_stack_profile_s_error_names_that_profile_and_its_own_lines() {
+    // Two profiles: 30 points at x = 100 mm (lines 2-31), then 12 at x = 200 mm (lines 32-43), too few for a
+    // quartic.
+    let mut text = String::from("x,y,z\n");
+    for (x, count) in [(100.0, 30), (200.0, 12)] {
+        for line in circle_csv(count).lines().skip(1) {
+            text.push_str(&format!("{x},{line}\n"));
+        }
+    }
+    assert_eq!(
+        fit_error_with(&text, &["--stack", "--degree", "4"]),
+        "error: DIR/points.csv: lines 32-43: the profile at x = 200.000 mm: 12 points are too few for a degree-4 \
+         fit (it has 15 coefficients; give at least 15 points)"
     );
 }
 
