@@ -12,7 +12,7 @@ use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
 use crate::geometry::held_out::{
-    choose_degree, clean_fit_or_chosen, combined_scores, profile_scores,
+    choose_degree, clean_fit_or_chosen, combined_scores, held_out_scores,
 };
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
@@ -25,8 +25,8 @@ pub struct FitIpArgs {
     #[arg(long)]
     points: PathBuf,
     /// Degree of the polynomial (of each profile, for a stack; of each face, for a profile with sharp edges), 1 to
-    /// 16. By default a profile's (or each face's) is chosen from 4, 6 and 8 by the points held out of its fit, a
-    /// stack's (one for all its profiles) by the points held out of all of them; a surface is fitted at 4.
+    /// 16. By default a profile's, each face's or a surface's is chosen from 4, 6 and 8 by the points held out of its
+    /// fit, a stack's (one for all its profiles) by the points held out of all of them.
     #[arg(long, value_parser = degree)]
     degree: Option<usize>,
     /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
@@ -78,9 +78,6 @@ fn degree(text: &str) -> Result<usize, String> {
     }
 }
 
-/// The degree of a polynomial when none is given and none is chosen by the data.
-const DEFAULT_DEGREE: usize = 4;
-
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum EdgesArg {
     Auto,
@@ -101,12 +98,12 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let file = read_point_file(&args.points)?;
     warn_of_isolated_points(&file)?;
-    let options = FitOptions::new(args.degree.unwrap_or(DEFAULT_DEGREE), args.method.into());
+    let method: FitMethod = args.method.into();
     let lines = &file.lines;
     let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
             match fit_faces_of(args, &points)? {
-                Some(faced) => (ReferenceModel::Faces(faced), options.method),
+                Some(faced) => (ReferenceModel::Faces(faced), method),
                 None => one_polynomial(args, &points, lines)?,
             }
         }
@@ -119,18 +116,25 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
                 );
             }
             let normals = pca_normals(&points);
-            let fitted = fit_ip(&points, &normals, &options)
-                .map_err(|e| anyhow!("{}: {e}", rows_of(&args.points, lines, 0..points.len())))?;
-            print_fit(&args.points, "surface", &fitted, &points, args.tolerance)?;
+            let rows = || rows_of(&args.points, lines, 0..points.len());
+            let fitted = held_out_or_given(args.degree, &points, &normals, method, &rows)?;
+            print_fit(
+                &args.points,
+                "surface",
+                &fitted.fitted,
+                &points,
+                args.tolerance,
+            )?;
+            fitted.print_degree()?;
             warn_if_profiles(&points, args.plane_tolerance)?;
             (
-                ReferenceModel::Surface(FittedIp::from(fitted.clone())),
-                fitted.method,
+                ReferenceModel::Surface(FittedIp::from(fitted.fitted.clone())),
+                fitted.fitted.method,
             )
         }
         (PointSet::Spatial(points), true) => {
-            let profiles = fit_stack(&args.points, &points, lines, &options, args)?;
-            (ReferenceModel::Stack { profiles }, options.method)
+            let profiles = fit_stack(&args.points, &points, lines, method, args)?;
+            (ReferenceModel::Stack { profiles }, method)
         }
         (PointSet::Profile(_), true) => {
             bail!(
@@ -247,9 +251,7 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
     Ok(Some(faced))
 }
 
-/// A profile fitted as one polynomial, printed. Its degree is `--degree`'s, or else the one of 4, 6 and 8 that the
-/// points held out of its fit choose; where that degree's fit has a defect the statistics show (a spurious branch
-/// or sliver beside the data, points with no foot), the next best by held-out RMS whose fit has none.
+/// A profile fitted as one polynomial, printed, at the degree [`held_out_or_given`] takes.
 fn one_polynomial(
     args: &FitIpArgs,
     points: &[Vector2<f64>],
@@ -258,53 +260,94 @@ fn one_polynomial(
     let path = &args.points;
     let rows = || rows_of(path, lines, 0..points.len());
     let normals = profile_normals(points, args.normals).map_err(|e| anyhow!("{}: {e}", rows()))?;
-    let method: FitMethod = args.method.into();
-    let fit = |degree: usize| {
-        fit_ip(points, &normals, &FitOptions::new(degree, method))
-            .map_err(|e| anyhow!("{}: {e}", rows()))
-    };
-    let (fitted, scores, chosen, passed_over) = match args.degree {
-        Some(degree) => (fit(degree)?, Vec::new(), degree, None),
-        None => {
-            let scores = profile_scores(points, &normals, method);
-            let chosen = choose_degree(&scores);
-            let mut passed_over = None;
-            let fitted = clean_fit_or_chosen(
-                chosen,
-                &scores,
-                |degree| {
-                    let result = fit(degree);
-                    if degree == chosen {
-                        passed_over = match &result {
-                            Ok(fitted) => defects(fitted).map(|d| format!("fits with {d}")),
-                            Err(e) => Some(format!("fails ({e:#})")),
-                        };
-                    }
-                    result
-                },
-                |fitted| defects(fitted).is_none(),
-            )?;
-            (fitted, scores, chosen, passed_over)
+    let fitted = held_out_or_given(args.degree, points, &normals, args.method.into(), &rows)?;
+    print_fit(path, "profile", &fitted.fitted, points, args.tolerance)?;
+    fitted.print_degree()?;
+    Ok((
+        ReferenceModel::Profile(FittedIp::from(fitted.fitted.clone())),
+        fitted.fitted.method,
+    ))
+}
+
+/// One polynomial's fit, and how its degree was chosen when none was given.
+struct DegreeChosen<const N: usize> {
+    fitted: Fitted<N>,
+    /// The held-out RMS of each degree tried; empty when the degree was given.
+    scores: Vec<(usize, f64)>,
+    /// The degree the held-out points chose, and why its fit was passed over where another was taken.
+    chosen: usize,
+    passed_over: Option<String>,
+}
+
+impl<const N: usize> DegreeChosen<N> {
+    /// The line saying how the degree was chosen (nothing when it was given).
+    fn print_degree(&self) -> anyhow::Result<()> {
+        if self.scores.is_empty() {
+            return Ok(());
         }
-    };
-    print_fit(path, "profile", &fitted, points, args.tolerance)?;
-    if !scores.is_empty() {
-        let degree = fitted.model.degree();
-        let why = match passed_over.filter(|_| degree != chosen) {
+        let degree = self.fitted.model.degree();
+        let why = match self.passed_over.as_ref().filter(|_| degree != self.chosen) {
             None => "chosen by".to_string(),
             Some(problem) => format!(
-                "taken because degree {chosen}, chosen by the points held out, {problem}; see"
+                "taken because degree {}, chosen by the points held out, {problem}; see",
+                self.chosen
             ),
         };
         reportln!(
             "  degree {degree} {why} the RMS distance of the points held out of the fit ({}); --degree gives one",
-            held_out_list(&scores)
+            held_out_list(&self.scores)
         )?;
+        Ok(())
     }
-    Ok((
-        ReferenceModel::Profile(FittedIp::from(fitted.clone())),
-        fitted.method,
-    ))
+}
+
+/// One polynomial fitted to points (a profile's or a surface's) at `degree`, or where none is given at the one of
+/// 4, 6 and 8 that the points held out of its fit choose; where that degree's fit has a defect the statistics show
+/// (a spurious branch or sliver beside the data, points with no foot), the next best by held-out RMS whose fit has
+/// none. `rows` names the points in an error.
+fn held_out_or_given<const N: usize>(
+    degree: Option<usize>,
+    points: &[SVector<f64, N>],
+    normals: &[SVector<f64, N>],
+    method: FitMethod,
+    rows: &dyn Fn() -> String,
+) -> anyhow::Result<DegreeChosen<N>> {
+    let fit = |degree: usize| {
+        fit_ip(points, normals, &FitOptions::new(degree, method))
+            .map_err(|e| anyhow!("{}: {e}", rows()))
+    };
+    if let Some(degree) = degree {
+        return Ok(DegreeChosen {
+            fitted: fit(degree)?,
+            scores: Vec::new(),
+            chosen: degree,
+            passed_over: None,
+        });
+    }
+    let scores = held_out_scores(points, normals, method);
+    let chosen = choose_degree(&scores);
+    let mut passed_over = None;
+    let fitted = clean_fit_or_chosen(
+        chosen,
+        &scores,
+        |degree| {
+            let result = fit(degree);
+            if degree == chosen {
+                passed_over = match &result {
+                    Ok(fitted) => defects(fitted).map(|d| format!("fits with {d}")),
+                    Err(e) => Some(format!("fails ({e:#})")),
+                };
+            }
+            result
+        },
+        |fitted| defects(fitted).is_none(),
+    )?;
+    Ok(DegreeChosen {
+        fitted,
+        scores,
+        chosen,
+        passed_over,
+    })
 }
 
 /// Whether the points are in scan order: nearly every step to the next point is about as short as the step to
@@ -353,7 +396,7 @@ fn fit_stack(
     path: &Path,
     points: &[Vector3<f64>],
     lines: &[u64],
-    options: &FitOptions,
+    method: FitMethod,
     args: &FitIpArgs,
 ) -> anyhow::Result<Vec<StackProfile>> {
     let planes = group_into_planes(points, args.plane_tolerance);
@@ -377,7 +420,7 @@ fn fit_stack(
         profiles.push((x, yz, normals, rows));
     }
     let fit_at = |degree: usize| -> anyhow::Result<Vec<Fitted<2>>> {
-        let options = FitOptions { degree, ..*options };
+        let options = FitOptions::new(degree, method);
         profiles
             .iter()
             .map(|(x, yz, normals, rows)| {
@@ -391,9 +434,7 @@ fn fit_stack(
         None => {
             let each: Vec<(usize, Vec<(usize, f64)>)> = profiles
                 .iter()
-                .map(|(_, yz, normals, _)| {
-                    (yz.len() / 2, profile_scores(yz, normals, options.method))
-                })
+                .map(|(_, yz, normals, _)| (yz.len() / 2, held_out_scores(yz, normals, method)))
                 .collect();
             let scores = combined_scores(&each);
             let chosen = choose_degree(&scores);
@@ -461,7 +502,7 @@ fn fit_stack(
 
 /// The defects a fit's statistics show, as a phrase ("2 spurious branches beside the data and 3 points with no
 /// foot"), or `None` for a clean fit: a spurious branch or sliver beside the data, or a point with no foot.
-fn defects(fitted: &Fitted<2>) -> Option<String> {
+fn defects<const N: usize>(fitted: &Fitted<N>) -> Option<String> {
     let s = &fitted.stats;
     let count = |n: usize, one: &str, many: &str| match n {
         0 => None,

@@ -2,7 +2,7 @@
 //! rises (a higher degree also follows the noise); the distance of points it was not fitted to stops falling once
 //! the shape is followed, and that is the degree the data supports.
 
-use nalgebra::Vector2;
+use nalgebra::SVector;
 
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions};
 use crate::geometry::implicit::Implicit;
@@ -60,7 +60,10 @@ pub(crate) fn clean_fit_or_chosen<T, E>(
 
 /// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
 /// the model, where the first-order distance is exact to second order.
-pub(crate) fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) -> f64 {
+pub(crate) fn rms_distance<const N: usize>(
+    model: &impl Implicit<N>,
+    points: &[SVector<f64, N>],
+) -> f64 {
     let sum: f64 = points
         .iter()
         .map(|p| {
@@ -71,17 +74,17 @@ pub(crate) fn rms_distance(model: &impl Implicit<2>, points: &[Vector2<f64>]) ->
     (sum / points.len() as f64).sqrt()
 }
 
-/// The held-out RMS (mm) of each of [`CANDIDATE_DEGREES`] for one polynomial round a profile whose points run
-/// along it: each degree fitted to every other point (with its normal), judged by the points between. A degree
-/// whose fit fails is left out.
-pub(crate) fn profile_scores(
-    points: &[Vector2<f64>],
-    normals: &[Vector2<f64>],
+/// The held-out RMS (mm) of each of [`CANDIDATE_DEGREES`] for one polynomial through points with their normals (a
+/// profile's, running along it, or a surface's): each degree fitted to every other point, judged by the points
+/// between. A degree whose fit fails is left out.
+pub(crate) fn held_out_scores<const N: usize>(
+    points: &[SVector<f64, N>],
+    normals: &[SVector<f64, N>],
     method: FitMethod,
 ) -> Vec<(usize, f64)> {
     let (trained, trained_normals): (Vec<_>, Vec<_>) =
         points.iter().zip(normals).step_by(2).unzip();
-    let judged: Vec<Vector2<f64>> = points.iter().skip(1).step_by(2).copied().collect();
+    let judged: Vec<SVector<f64, N>> = points.iter().skip(1).step_by(2).copied().collect();
     CANDIDATE_DEGREES
         .into_iter()
         .filter_map(|degree| {
@@ -93,7 +96,7 @@ pub(crate) fn profile_scores(
 }
 
 /// The held-out RMS (mm) of each degree over several profiles fitted at one degree (a stack's: its profiles blend
-/// only at equal degrees), from each profile's points held out and [`profile_scores`]: the root of the mean
+/// only at equal degrees), from each profile's points held out and [`held_out_scores`]: the root of the mean
 /// square over every held-out point, so each profile weighs by its points. A degree that some profile could not
 /// be fitted at is left out.
 pub(crate) fn combined_scores(profiles: &[(usize, Vec<(usize, f64)>)]) -> Vec<(usize, f64)> {
@@ -117,6 +120,7 @@ mod tests {
     use super::*;
     use crate::geometry::normals::ordered_profile_normals;
     use crate::geometry::trace::{resample_closed, trace_closed_curve};
+    use nalgebra::Vector2;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
@@ -205,7 +209,7 @@ mod tests {
         for seed in [1, 2, 3] {
             let points = noisy(&curve, 400, seed);
             let normals = ordered_profile_normals(&points);
-            let scores = profile_scores(&points, &normals, FitMethod::default());
+            let scores = held_out_scores(&points, &normals, FitMethod::default());
             assert_eq!(choose_degree(&scores), 4, "seed {seed}: {scores:?}");
             assert!(scores[0].1 < 0.003, "seed {seed}: {scores:?}");
         }
@@ -229,7 +233,7 @@ mod tests {
             .collect();
         let points = noisy(&stadium, 400, 7);
         let normals = ordered_profile_normals(&points);
-        let scores = profile_scores(&points, &normals, FitMethod::default());
+        let scores = held_out_scores(&points, &normals, FitMethod::default());
         let chosen = choose_degree(&scores);
         let rms_of = |degree: usize| scores.iter().find(|s| s.0 == degree).unwrap().1;
         assert!(chosen > 4, "{scores:?}");

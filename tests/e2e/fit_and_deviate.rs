@@ -2,6 +2,9 @@
 
 use std::path::PathBuf;
 
+use rand::SeedableRng;
+use rand_distr::Distribution;
+
 use zeroset_sim::naca::Naca4;
 
 use crate::support::{config, deviate, fit_ip, mean, naca_csv, zeroset_with_stdout_closed};
@@ -226,19 +229,14 @@ pub fn ellipsoid_csv(path: &std::path::Path, count: usize, offset: f64) {
     std::fs::write(path, text).unwrap();
 }
 
-#[test]
-fn a_stack_without_a_degree_takes_the_one_the_points_held_out_of_all_its_profiles_choose() {
-    // The blade's NACA profiles have sharp trailing edges, which no quartic follows: the points held out of the
-    // five profiles' fits choose a higher degree, one for all of them (profiles blend only at equal degrees).
-    let dir = tempfile::tempdir().unwrap();
-    let points = config("profiles/naca-blade-a-5-profiles.csv");
-    let (fit, saved) = fit_ip(&points, &["--stack"], &dir.path().join("stack.json"));
-    // "stack degree D chosen by the RMS distance ... (4: a um, 6: b um, 8: c um); --degree gives one"
+/// The degree a fit's output says it took, each degree's held-out RMS (um) and the line: the line starting with
+/// `start`, as "D chosen by the RMS distance ... (4: a um, 6: b um, 8: c um); --degree gives one".
+fn degree_said(fit: &str, start: &str) -> (usize, Vec<(usize, f64)>, String) {
     let line = fit
         .lines()
-        .find(|l| l.starts_with("stack degree "))
-        .unwrap_or_else(|| panic!("no stack degree said: {fit}"));
-    let degree: usize = line["stack degree ".len()..]
+        .find(|l| l.starts_with(start))
+        .unwrap_or_else(|| panic!("no '{start}' line: {fit}"));
+    let degree: usize = line[start.len()..]
         .split(' ')
         .next()
         .and_then(|d| d.parse().ok())
@@ -258,13 +256,30 @@ fn a_stack_without_a_degree_takes_the_one_the_points_held_out_of_all_its_profile
         vec![4, 6, 8],
         "{line}"
     );
-    // From the lowest up, a higher degree replaces the one chosen so far only by beating its held-out RMS by 10%.
+    (degree, scores, line.to_string())
+}
+
+/// The degree and held-out RMS the rule takes: from the lowest up, a higher degree replaces the one chosen so far
+/// only by beating its held-out RMS by 10%.
+fn degree_by_the_rule(scores: &[(usize, f64)]) -> (usize, f64) {
     let mut expected = scores[0];
     for &score in &scores[1..] {
         if score.1 < 0.9 * expected.1 {
             expected = score;
         }
     }
+    expected
+}
+
+#[test]
+fn a_stack_without_a_degree_takes_the_one_the_points_held_out_of_all_its_profiles_choose() {
+    // The blade's NACA profiles have sharp trailing edges, which no quartic follows: the points held out of the
+    // five profiles' fits choose a higher degree, one for all of them (profiles blend only at equal degrees).
+    let dir = tempfile::tempdir().unwrap();
+    let points = config("profiles/naca-blade-a-5-profiles.csv");
+    let (fit, saved) = fit_ip(&points, &["--stack"], &dir.path().join("stack.json"));
+    let (degree, scores, line) = degree_said(&fit, "stack degree ");
+    let expected = degree_by_the_rule(&scores);
     assert!(
         degree == expected.0 && line.starts_with(&format!("stack degree {degree} chosen by ")),
         "{line}"
@@ -301,6 +316,9 @@ fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
     let (fit, saved) = fit_ip(master.to_str().unwrap(), &[], &model);
     assert!(fit.contains("(surface) to 1500 points"), "{fit}");
     assert_eq!(saved["model"]["kind"], "ip-surface");
+    // An ellipsoid is a quadric: no higher degree follows it better, and the lowest tried is kept.
+    let (degree, _, line) = degree_said(&fit, "  degree ");
+    assert!(degree == 4 && line.contains("chosen by"), "{line}");
     let values = exact_deviations(
         &model,
         part.to_str().unwrap(),
@@ -311,6 +329,51 @@ fn a_surface_fitted_to_3d_points_measures_an_offset_surface() {
         "an offset of 0.25 mm everywhere: {:?}",
         &values[..5]
     );
+}
+
+#[test]
+fn a_surface_without_a_degree_takes_the_one_its_held_out_points_choose() {
+    // x^6/a^6 + y^6/b^6 + z^6/c^6 = 1, a rounded box of 80 x 60 x 40 mm: a sextic, which no quartic follows, with
+    // 2 um of noise along the normal. Degree 6 follows it to the noise; 8 follows the noise too, no closer.
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("box.csv");
+    let sizes = [40.0, 30.0, 20.0];
+    let mut rng = rand::rngs::StdRng::seed_from_u64(606);
+    let noise = rand_distr::Normal::new(0.0, 0.002).unwrap();
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut text = String::from("x,y,z\n");
+    for i in 0..2000 {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
+        let r = (1.0 - z * z).sqrt();
+        let phi = golden * i as f64;
+        let u = [r * phi.cos(), r * phi.sin(), z];
+        let reach = (0..3)
+            .map(|k| (u[k] / sizes[k]).powi(6))
+            .sum::<f64>()
+            .powf(-1.0 / 6.0);
+        let p: Vec<f64> = u.iter().map(|c| c * reach).collect();
+        let gradient: Vec<f64> = (0..3).map(|k| p[k].powi(5) / sizes[k].powi(6)).collect();
+        let length = gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
+        let moved = noise.sample(&mut rng);
+        let q: Vec<String> = (0..3)
+            .map(|k| format!("{:.6}", p[k] + moved * gradient[k] / length))
+            .collect();
+        text.push_str(&q.join(","));
+        text.push('\n');
+    }
+    std::fs::write(&points, text).unwrap();
+    let (fit, saved) = fit_ip(points.to_str().unwrap(), &[], &dir.path().join("box.json"));
+    let (degree, scores, line) = degree_said(&fit, "  degree ");
+    let expected = degree_by_the_rule(&scores);
+    assert!(
+        degree == 6 && expected.0 == 6 && line.contains("chosen by"),
+        "{line}"
+    );
+    assert!(
+        scores[0].1 > 5.0 * expected.1 && expected.1 < 3.0,
+        "a quartic misses the box's corners by far more than the noise: {line}"
+    );
+    assert_eq!(saved["model"]["ip"]["poly"]["degree"], 6, "{fit}");
 }
 
 #[test]

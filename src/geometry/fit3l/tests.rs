@@ -152,7 +152,7 @@ fn seed_003_s_published_profiles_refitted_from_20_noise_draws_lie_within_2_um_of
         for draw in 0..20 {
             let measured = noisy(model, clean, 0.002, 3000 + draw);
             let normals = ordered_profile_normals(&measured);
-            let scores = crate::geometry::held_out::profile_scores(
+            let scores = crate::geometry::held_out::held_out_scores(
                 &measured,
                 &normals,
                 FitMethod::default(),
