@@ -12,7 +12,7 @@ use crate::analysis::fit_sanity;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
 use crate::geometry::held_out::{
-    choose_degree, clean_fit_or_chosen, combined_scores, held_out_scores,
+    choose_degree, clean_fit_or_chosen, combined_scores, held_out_scores, CANDIDATE_DEGREES,
 };
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
@@ -26,7 +26,8 @@ pub struct FitIpArgs {
     points: PathBuf,
     /// Degree of the polynomial (of each profile, for a stack; of each face, for a profile with sharp edges), 1 to
     /// 16. By default a profile's, each face's or a surface's is chosen from 4, 6 and 8 by the points held out of its
-    /// fit, a stack's (one for all its profiles) by the points held out of all of them.
+    /// fit, a stack's (one for all its profiles) by the points held out of all of them; a surface through profiles
+    /// (points in parallel planes of constant x) takes 4.
     #[arg(long, value_parser = degree)]
     degree: Option<usize>,
     /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
@@ -117,7 +118,13 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             }
             let normals = pca_normals(&points);
             let rows = || rows_of(&args.points, lines, 0..points.len());
-            let fitted = held_out_or_given(args.degree, &points, &normals, method, &rows)?;
+            // Profiles' points held out judge a surface only in their own planes, which a higher degree passes
+            // through exactly whatever it does between them: their surface keeps the lowest degree.
+            let planes = profile_planes(&points, args.plane_tolerance);
+            let degree = args
+                .degree
+                .or(planes.as_ref().map(|_| CANDIDATE_DEGREES[0]));
+            let fitted = held_out_or_given(degree, &points, &normals, method, &rows)?;
             print_fit(
                 &args.points,
                 "surface",
@@ -126,7 +133,24 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
                 args.tolerance,
             )?;
             fitted.print_degree()?;
-            warn_if_profiles(&points, args.plane_tolerance)?;
+            if let Some(xs) = planes {
+                let xs: Vec<String> = xs.iter().map(|x| format!("{x:.3}")).collect();
+                reportln!(
+                    "  warning: the points lie in {} parallel planes of constant x (x = {} mm): they are \
+                     profiles, which one surface does not model; fit them with --stack{}",
+                    xs.len(),
+                    xs.join(", "),
+                    if args.degree.is_none() {
+                        format!(
+                            " (the surface took degree {}: points held out of profiles cannot judge it \
+                             between their planes)",
+                            CANDIDATE_DEGREES[0]
+                        )
+                    } else {
+                        String::new()
+                    }
+                )?;
+            }
             (
                 ReferenceModel::Surface(FittedIp::from(fitted.fitted.clone())),
                 fitted.fitted.method,
@@ -635,24 +659,15 @@ fn warn_of_isolated_points(file: &PointFile) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// 3-D points fitted as one surface that lie in parallel planes of constant x are profiles: say so, and that
-/// `--stack` fits them as such.
-fn warn_if_profiles(points: &[Vector3<f64>], plane_tolerance: f64) -> anyhow::Result<()> {
+/// The planes of constant x (their mean x) that 3-D points lie in when they are profiles: two or more planes,
+/// each holding a scanned profile's points. `None` for points spread over a surface.
+fn profile_planes(points: &[Vector3<f64>], plane_tolerance: f64) -> Option<Vec<f64>> {
     let planes = group_into_planes(points, plane_tolerance);
     let profiles = planes.len() >= 2
         && planes
             .iter()
             .all(|(_, plane)| plane.len() >= MIN_PROFILE_POINTS);
-    if profiles {
-        let xs: Vec<String> = planes.iter().map(|(x, _)| format!("{x:.3}")).collect();
-        reportln!(
-            "  warning: the points lie in {} parallel planes of constant x (x = {} mm): they are profiles, \
-             which one surface does not model; fit them with --stack",
-            planes.len(),
-            xs.join(", ")
-        )?;
-    }
-    Ok(())
+    profiles.then(|| planes.iter().map(|(x, _)| *x).collect())
 }
 
 /// A plane of constant x holding at least this many points is a scanned profile, not a scatter of surface points.

@@ -67,9 +67,16 @@ fn profiles_fitted_as_one_surface_are_told_to_use_stack() {
     );
     assert!(
         said.iter()
-            .any(|w| w.contains("5 parallel planes of constant x") && w.contains("--stack")),
+            .any(|w| w.contains("5 parallel planes of constant x")
+                && w.contains("--stack")
+                && w.contains(
+                    "the surface took degree 4: points held out of profiles cannot judge it"
+                )),
         "{printed}"
     );
+    // Held out, the profiles' points would choose a degree that passes through every plane and models nothing
+    // between them.
+    assert_eq!(saved["model"]["ip"]["poly"]["degree"], 4, "{printed}");
     // As a stack the same points raise neither doubt.
     let (printed, _) = fit_ip(&points, &["--stack"], &dir.path().join("stack.json"));
     assert!(
