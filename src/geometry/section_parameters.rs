@@ -121,7 +121,8 @@ pub struct SectionParameters {
 
 /// The mean (camber) line: the centres of the circles inscribed in the section, each touching both faces, from
 /// the leading to the trailing edge (stations whose circles keep [`END_CLEARANCE`] clear of both ends); its ends
-/// are where it meets the outline, followed out as a parabola through its first and last [`END_STRETCH`]. The line joining those ends is the chord line of blade software, from which
+/// are a sharp edge's tip, or where it meets a round edge's outline, followed out as a parabola through its first
+/// or last [`END_STRETCH`]. The line joining those ends is the chord line of blade software, from which
 /// camber and chord angle are measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeanLine {
@@ -243,7 +244,13 @@ pub(crate) fn section_parameters(
             (station, 2.0 * across.inscribed_at(station)?)
         }
     };
-    let mean_line = MeanLine::of(&across, chord_mm)?;
+    // A sharp end is the mean line's end itself (a NACA section's closed trailing edge is where its mean line
+    // ends); a round one's end is found by following the mean line out.
+    let sharp_ends = [
+        le_circle.is_none().then_some(leading_edge),
+        te_circle.is_none().then_some(trailing_edge),
+    ];
+    let mean_line = MeanLine::of(&across, chord_mm, sharp_ends)?;
     Ok(SectionParameters {
         leading_edge,
         trailing_edge,
@@ -300,7 +307,12 @@ fn edge_circle(
 }
 
 impl MeanLine {
-    fn of(across: &Across, chord_mm: f64) -> Result<MeanLine, ParameterError> {
+    /// `sharp_ends`: the leading and trailing edges' tips where they are sharp, which are the line's ends.
+    fn of(
+        across: &Across,
+        chord_mm: f64,
+        sharp_ends: [Option<Vector2<f64>>; 2],
+    ) -> Result<MeanLine, ParameterError> {
         let clear = END_CLEARANCE * chord_mm;
         let mut centres = Vec::new();
         let mut thicknesses_mm = Vec::new();
@@ -354,8 +366,8 @@ impl MeanLine {
             }
             Ok(at((inside + outside) / 2.0))
         };
-        let leading_end = end(first, -1.0)?;
-        let trailing_end = end(last, 1.0)?;
+        let leading_end = sharp_ends[0].map_or_else(|| end(first, -1.0), Ok)?;
+        let trailing_end = sharp_ends[1].map_or_else(|| end(last, 1.0), Ok)?;
         let chord = trailing_end - leading_end;
         let (along, normal) = (
             chord.normalize(),
