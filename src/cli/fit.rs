@@ -310,7 +310,7 @@ impl<const N: usize> DegreeChosen<N> {
             return Ok(());
         }
         let degree = self.fitted.model.degree();
-        let why = match self.passed_over.as_ref().filter(|_| degree != self.chosen) {
+        let why = match &self.passed_over {
             None => "chosen by".to_string(),
             Some(problem) => format!(
                 "taken because degree {}, chosen by the points held out, {problem}; see",
@@ -350,22 +350,10 @@ fn held_out_or_given<const N: usize>(
     }
     let scores = held_out_scores(points, normals, method);
     let chosen = choose_degree(&scores);
-    let mut passed_over = None;
-    let fitted = clean_fit_or_chosen(
-        chosen,
-        &scores,
-        |degree| {
-            let result = fit(degree);
-            if degree == chosen {
-                passed_over = match &result {
-                    Ok(fitted) => defects(fitted).map(|d| format!("fits with {d}")),
-                    Err(e) => Some(format!("fails ({e:#})")),
-                };
-            }
-            result
-        },
-        |fitted| defects(fitted).is_none(),
-    )?;
+    let (fitted, passed_over) = clean_fit_or_chosen(chosen, &scores, fit, |fitted| {
+        defects(fitted).map(|d| format!("fits with {d}"))
+    });
+    let fitted = fitted?;
     Ok(DegreeChosen {
         fitted,
         scores,
@@ -462,38 +450,25 @@ fn fit_stack(
                 .collect();
             let scores = combined_scores(&each);
             let chosen = choose_degree(&scores);
-            let mut passed_over = None;
-            let fits = clean_fit_or_chosen(
-                chosen,
-                &scores,
-                |degree| {
-                    let result = fit_at(degree);
-                    if degree == chosen {
-                        passed_over = Some(match &result {
-                            Ok(fits) => profiles
-                                .iter()
-                                .zip(fits)
-                                .filter_map(|((x, ..), fitted)| {
-                                    let defects = defects(fitted)?;
-                                    Some(format!(
-                                        "the profile at x = {x:.3} mm fits with {defects}"
-                                    ))
-                                })
-                                .collect::<Vec<_>>()
-                                .join("; "),
-                            Err(e) => format!("{e:#}"),
-                        });
-                    }
-                    result
-                },
-                |fits: &Vec<Fitted<2>>| fits.iter().all(|f| defects(f).is_none()),
-            )?;
+            let (fits, passed_over) =
+                clean_fit_or_chosen(chosen, &scores, fit_at, |fits: &Vec<Fitted<2>>| {
+                    let defects: Vec<String> = profiles
+                        .iter()
+                        .zip(fits)
+                        .filter_map(|((x, ..), fitted)| {
+                            let defects = defects(fitted)?;
+                            Some(format!("the profile at x = {x:.3} mm fits with {defects}"))
+                        })
+                        .collect();
+                    (!defects.is_empty()).then(|| defects.join("; "))
+                });
+            let fits = fits?;
             (fits, scores, chosen, passed_over)
         }
     };
     if !scores.is_empty() {
         let degree = fits[0].model.degree();
-        let why = match passed_over.filter(|_| degree != chosen) {
+        let why = match passed_over {
             None => "chosen by".to_string(),
             Some(problem) => format!(
                 "taken because at degree {chosen}, chosen by the points held out, {problem}; see"

@@ -39,23 +39,31 @@ pub(crate) fn degrees_to_try(chosen: usize, scores: &[(usize, f64)]) -> Vec<usiz
         .collect()
 }
 
-/// The fit to keep once a degree is chosen: the chosen degree's where it is `clean` (none of the defects a fit's
-/// statistics show), else the first clean one of the other degrees, best held-out first; where none is, the chosen
-/// degree's own result (its fit, whose defects its statistics report, or its error).
-pub(crate) fn clean_fit_or_chosen<T, E>(
+/// The fit to keep once a degree is chosen: the chosen degree's where it is clean (`defects` finds none of the
+/// defects a fit's statistics show), else the first clean one of the other degrees, best held-out first; where none
+/// is, the chosen degree's own result (its fit, whose defects its statistics report, or its error). With it, why
+/// the chosen degree's fit was passed over ("fails (...)" or what `defects` said), when another is kept.
+pub(crate) fn clean_fit_or_chosen<T, E: std::fmt::Display>(
     chosen: usize,
     scores: &[(usize, f64)],
     mut fit: impl FnMut(usize) -> Result<T, E>,
-    clean: impl Fn(&T) -> bool,
-) -> Result<T, E> {
+    defects: impl Fn(&T) -> Option<String>,
+) -> (Result<T, E>, Option<String>) {
     let first = fit(chosen);
-    if first.as_ref().is_ok_and(&clean) {
-        return first;
+    let passed_over = match &first {
+        Ok(fitted) => defects(fitted),
+        Err(e) => Some(format!("fails ({e})")),
+    };
+    if passed_over.is_none() {
+        return (first, None);
     }
-    degrees_to_try(chosen, scores)[1..]
+    let other = degrees_to_try(chosen, scores)[1..]
         .iter()
-        .find_map(|&degree| fit(degree).ok().filter(&clean))
-        .map_or(first, Ok)
+        .find_map(|&degree| fit(degree).ok().filter(|f| defects(f).is_none()));
+    match other {
+        Some(other) => (Ok(other), passed_over),
+        None => (first, None),
+    }
 }
 
 /// RMS first-order distance |F| / |grad F| of points to a model, mm: the held-out points lie within the noise of
@@ -151,30 +159,43 @@ mod tests {
         // A fit stands for its degree; `clean` and the errors are given per degree.
         let keep = |clean: &[usize], failing: &[usize]| {
             let mut tried = Vec::new();
-            let kept = clean_fit_or_chosen(
+            let (kept, passed_over) = clean_fit_or_chosen(
                 6,
                 &scores,
                 |degree| {
                     tried.push(degree);
                     if failing.contains(&degree) {
-                        Err(degree)
+                        Err(format!("degree {degree} failed"))
                     } else {
                         Ok(degree)
                     }
                 },
-                |degree| clean.contains(degree),
+                |degree| (!clean.contains(degree)).then(|| format!("fits degree {degree} badly")),
             );
-            (kept, tried)
+            (kept, passed_over, tried)
         };
-        assert_eq!(keep(&[4, 6, 8], &[]), (Ok(6), vec![6]));
-        // Unclean: the others best held-out first (8 before 4), the first clean one kept.
-        assert_eq!(keep(&[4, 8], &[]), (Ok(8), vec![6, 8]));
-        assert_eq!(keep(&[4], &[8]), (Ok(4), vec![6, 8, 4]));
+        let said = |text: &str| Some(text.to_string());
+        assert_eq!(keep(&[4, 6, 8], &[]), (Ok(6), None, vec![6]));
+        // Unclean: the others best held-out first (8 before 4), the first clean one kept, and why 6 was not.
+        assert_eq!(
+            keep(&[4, 8], &[]),
+            (Ok(8), said("fits degree 6 badly"), vec![6, 8])
+        );
+        assert_eq!(
+            keep(&[4], &[8]),
+            (Ok(4), said("fits degree 6 badly"), vec![6, 8, 4])
+        );
         // The chosen one failing does not end the search.
-        assert_eq!(keep(&[4], &[6]), (Ok(4), vec![6, 8, 4]));
-        // No degree clean: the chosen one's fit, or its error.
-        assert_eq!(keep(&[], &[]), (Ok(6), vec![6, 8, 4]));
-        assert_eq!(keep(&[], &[6]), (Err(6), vec![6, 8, 4]));
+        assert_eq!(
+            keep(&[4], &[6]),
+            (Ok(4), said("fails (degree 6 failed)"), vec![6, 8, 4])
+        );
+        // No degree clean: the chosen one's fit, or its error, with nothing passed over.
+        assert_eq!(keep(&[], &[]), (Ok(6), None, vec![6, 8, 4]));
+        assert_eq!(
+            keep(&[], &[6]),
+            (Err("degree 6 failed".to_string()), None, vec![6, 8, 4])
+        );
     }
 
     #[test]

@@ -434,6 +434,32 @@ fn a_noisy_scans_maximum_thickness_is_not_read_at_its_luckiest_station() {
     }
 }
 
+/// NACA 4412 of 150 mm chord with its trailing edge closed: 30 000 points from the tail.
+fn naca_4412_of_150_mm() -> Vec<Vector2<f64>> {
+    Naca4::from_digits("4412", 150.0, true)
+        .unwrap()
+        .points(30000)
+        .into_iter()
+        .map(|[x, y]| Vector2::new(x, y))
+        .collect()
+}
+
+/// A scan that starts at a sharp trailing edge, its first point replaced by the 16 contacts of a ball rolling round
+/// the edge, each `apex` within 2 um of noise on each axis; and the contacts' indices.
+fn with_roll_contacts(
+    scan: &[Vector2<f64>],
+    apex: Vector2<f64>,
+    rng: &mut rand::rngs::StdRng,
+) -> (Vec<Vector2<f64>>, Vec<usize>) {
+    use rand_distr::Distribution;
+    let noise = rand_distr::Normal::new(0.0, 0.002).unwrap();
+    let mut outline: Vec<Vector2<f64>> = (0..16)
+        .map(|_| apex + Vector2::new(noise.sample(rng), noise.sample(rng)))
+        .collect();
+    outline.extend_from_slice(&scan[1..]);
+    (outline, (0..16).collect())
+}
+
 #[test]
 fn a_sharp_edges_tip_is_the_mean_of_the_contacts_rolling_round_it() {
     // A scan rolls the ball round a sharp trailing edge: some 16 contacts, each the apex within the noise (2 um
@@ -441,26 +467,15 @@ fn a_sharp_edges_tip_is_the_mean_of_the_contacts_rolling_round_it() {
     // 3.4 um on average; the mean of the contacts the compensation names, within 1.2 um of it (-0.1 um on
     // average).
     use rand::{Rng, SeedableRng};
-    use rand_distr::Distribution;
     let mut rng = rand::rngs::StdRng::seed_from_u64(43);
-    let noise = rand_distr::Normal::new(0.0, 0.002).unwrap();
-    let dense: Vec<Vector2<f64>> = Naca4::from_digits("4412", 150.0, true)
-        .unwrap()
-        .points(30000)
-        .into_iter()
-        .map(|[x, y]| Vector2::new(x, y))
-        .collect();
+    let dense = naca_4412_of_150_mm();
     let truth = section_parameters(&dense, &[], 2.0).unwrap();
     let along = (truth.trailing_edge - truth.leading_edge).normalize();
     let (mut named, mut farthest) = (Vec::new(), Vec::new());
     for _ in 0..20 {
         let scan = stepped(&dense, 0.75 + 0.5 * rng.gen::<f64>(), rng.gen());
         // The tail (the scan's first point) becomes the roll's contacts.
-        let mut outline: Vec<Vector2<f64>> = (0..16)
-            .map(|_| scan[0] + Vector2::new(noise.sample(&mut rng), noise.sample(&mut rng)))
-            .collect();
-        outline.extend_from_slice(&scan[1..]);
-        let contacts: Vec<usize> = (0..16).collect();
+        let (outline, contacts) = with_roll_contacts(&scan, scan[0], &mut rng);
         let tip_error = |contacts: &[usize]| {
             let p = section_parameters(&outline, contacts, 2.0).unwrap();
             (p.trailing_edge - truth.trailing_edge).dot(&along)
@@ -507,15 +522,8 @@ fn a_sharp_trailing_edge_s_apex_is_the_mean_line_s_end_and_steadies_the_chord_an
     // contacts give. Followed out from the inscribed circles' centres instead, the end moved across the chord with
     // the faces' noise.
     use rand::{Rng, SeedableRng};
-    use rand_distr::Distribution;
     let mut rng = rand::rngs::StdRng::seed_from_u64(4412);
-    let noise = rand_distr::Normal::new(0.0, 0.002).unwrap();
-    let dense: Vec<Vector2<f64>> = Naca4::from_digits("4412", 150.0, true)
-        .unwrap()
-        .points(30000)
-        .into_iter()
-        .map(|[x, y]| Vector2::new(x, y))
-        .collect();
+    let dense = naca_4412_of_150_mm();
     let truth = section_parameters(&dense, &[], 2.0).unwrap();
     assert_eq!(truth.mean_line.trailing_end, truth.trailing_edge);
     let mut errors = Vec::new();
@@ -525,11 +533,7 @@ fn a_sharp_trailing_edge_s_apex_is_the_mean_line_s_end_and_steadies_the_chord_an
             0.002,
             rng.gen(),
         );
-        let mut outline: Vec<Vector2<f64>> = (0..16)
-            .map(|_| dense[0] + Vector2::new(noise.sample(&mut rng), noise.sample(&mut rng)))
-            .collect();
-        outline.extend_from_slice(&scan[1..]);
-        let contacts: Vec<usize> = (0..16).collect();
+        let (outline, contacts) = with_roll_contacts(&scan, dense[0], &mut rng);
         let measured = section_parameters(&outline, &contacts, 2.0).unwrap();
         assert_eq!(measured.mean_line.trailing_end, measured.trailing_edge);
         errors.push(measured.mean_line.chord_angle_deg - truth.mean_line.chord_angle_deg);
