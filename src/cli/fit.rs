@@ -457,7 +457,7 @@ fn fit_stack(
                         .zip(fits)
                         .filter_map(|((x, ..), fitted)| {
                             let defects = defects(fitted)?;
-                            Some(format!("the profile at x = {x:.3} mm fits with {defects}"))
+                            Some(format!("fits the profile at x = {x:.3} mm with {defects}"))
                         })
                         .collect();
                     (!defects.is_empty()).then(|| defects.join("; "))
@@ -471,7 +471,7 @@ fn fit_stack(
         let why = match passed_over {
             None => "chosen by".to_string(),
             Some(problem) => format!(
-                "taken because at degree {chosen}, chosen by the points held out, {problem}; see"
+                "taken because degree {chosen}, chosen by the points held out, {problem}; see"
             ),
         };
         reportln!(
@@ -634,16 +634,21 @@ fn warn_of_isolated_points(file: &PointFile) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The planes of constant x (their mean x) that 3-D points lie in when they are profiles: two or more planes,
-/// each holding a scanned profile's points. `None` for points spread over a surface.
+/// The planes of constant x (their mean x) that 3-D points lie in when they are profiles: two or more planes each
+/// holding a scanned profile's points, together nearly all the points (a stray point off every plane does not make
+/// them a surface's). `None` for points spread over a surface.
 fn profile_planes(points: &[Vector3<f64>], plane_tolerance: f64) -> Option<Vec<f64>> {
-    let planes = group_into_planes(points, plane_tolerance);
-    let profiles = planes.len() >= 2
-        && planes
-            .iter()
-            .all(|(_, plane)| plane.len() >= MIN_PROFILE_POINTS);
-    profiles.then(|| planes.iter().map(|(x, _)| *x).collect())
+    let profiles: Vec<(f64, Vec<usize>)> = group_into_planes(points, plane_tolerance)
+        .into_iter()
+        .filter(|(_, plane)| plane.len() >= MIN_PROFILE_POINTS)
+        .collect();
+    let in_profiles: usize = profiles.iter().map(|(_, plane)| plane.len()).sum();
+    (profiles.len() >= 2 && in_profiles as f64 >= IN_PROFILES * points.len() as f64)
+        .then(|| profiles.iter().map(|(x, _)| *x).collect())
 }
+
+/// The share of 3-D points that planes of profiles hold when the points are profiles.
+const IN_PROFILES: f64 = 0.95;
 
 /// A plane of constant x holding at least this many points is a scanned profile, not a scatter of surface points.
 const MIN_PROFILE_POINTS: usize = 10;
@@ -651,6 +656,33 @@ const MIN_PROFILE_POINTS: usize = 10;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn profiles_are_told_from_a_surface_s_points_even_with_a_stray_point_off_their_planes() {
+        let circle = |x: f64| {
+            (0..20).map(move |i| {
+                let t = i as f64 / 20.0 * std::f64::consts::TAU;
+                Vector3::new(x, 10.0 * t.cos(), 5.0 * t.sin())
+            })
+        };
+        let mut profiles: Vec<Vector3<f64>> =
+            [100.0, 200.0, 300.0].into_iter().flat_map(circle).collect();
+        assert_eq!(
+            profile_planes(&profiles, 1.0),
+            Some(vec![100.0, 200.0, 300.0])
+        );
+        // One point between the planes is a plane of its own, too small for a profile.
+        profiles.push(Vector3::new(150.0, 0.0, 0.0));
+        assert_eq!(
+            profile_planes(&profiles, 1.0),
+            Some(vec![100.0, 200.0, 300.0])
+        );
+        // Points spread along x are a surface's.
+        let spread: Vec<Vector3<f64>> = (0..60)
+            .map(|i| Vector3::new(i as f64 * 5.0, (i as f64).cos(), (i as f64).sin()))
+            .collect();
+        assert_eq!(profile_planes(&spread, 1.0), None);
+    }
 
     #[test]
     fn a_fit_s_defects_are_named_with_their_counts() {

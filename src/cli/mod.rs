@@ -205,8 +205,10 @@ fn rows_of(
             (a, b) => format!("{a}-{b}"),
         })
         .collect();
-    if runs.len() > RUNS_NAMED {
-        named.push(format!("and {} more runs", runs.len() - RUNS_NAMED));
+    match runs.len().saturating_sub(RUNS_NAMED) {
+        0 => {}
+        1 => named.push("and 1 more run".to_string()),
+        more => named.push(format!("and {more} more runs")),
     }
     let word = if runs.len() == 1 && runs[0].0 == runs[0].1 {
         "line"
@@ -230,8 +232,12 @@ mod tests {
         assert_eq!(rows_of(path, &lines, 3..9), "stack.csv: lines 6-11");
         assert_eq!(rows_of(path, &lines, [4]), "stack.csv: line 7");
         assert_eq!(
+            rows_of(path, &lines, [0, 2, 4, 6, 8]),
+            "stack.csv: lines 2, 4, 7, and 2 more runs"
+        );
+        assert_eq!(
             rows_of(path, &lines, [0, 2, 3, 5, 7, 8]),
-            "stack.csv: lines 2, 4-6, 8, and 1 more runs"
+            "stack.csv: lines 2, 4-6, 8, and 1 more run"
         );
     }
 }

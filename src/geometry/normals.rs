@@ -12,8 +12,9 @@ use super::small;
 /// Neighbours used for local PCA: enough to average out 2 um probe noise without smoothing over a trailing edge.
 const PCA_NEIGHBOURS: usize = 10;
 
-/// A profile whose last point lies farther than this many median steps from its first is an open arc (a scan of
-/// part of a section): its end points have no neighbour across the gap.
+/// A profile whose last point lies farther from its first than this many times its end steps (from the first
+/// point to the second, from the last but one to the last) is an open arc (a scan of part of a section): its end
+/// points have no neighbour across the gap.
 const OPEN_ARC_GAP_STEPS: f64 = 3.0;
 
 /// Normals of an ordered profile: perpendicular to the central-difference tangent, pointing away from the enclosed
@@ -45,16 +46,17 @@ pub fn ordered_profile_normals(points: &[Vector2<f64>]) -> Vec<Vector2<f64>> {
         .collect()
 }
 
-/// Whether the gap from the last point back to the first is several times the profile's median step.
+/// Whether the gap from the last point back to the first is several times the steps beside it (the local
+/// spacing: a closed scan dense round its edges and sparse along its faces has a gap like its steps there).
 fn is_open_arc(points: &[Vector2<f64>]) -> bool {
     let n = points.len();
     if n < 3 {
         return false;
     }
-    let mut steps: Vec<f64> = points.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
-    let middle = steps.len() / 2;
-    let median = *steps.select_nth_unstable_by(middle, f64::total_cmp).1;
-    (points[n - 1] - points[0]).norm() > OPEN_ARC_GAP_STEPS * median
+    let beside = (points[1] - points[0])
+        .norm()
+        .max((points[n - 1] - points[n - 2]).norm());
+    (points[n - 1] - points[0]).norm() > OPEN_ARC_GAP_STEPS * beside
 }
 
 /// Normals of unordered points by local PCA (the direction of least spread among the nearest neighbours),

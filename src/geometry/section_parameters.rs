@@ -201,13 +201,21 @@ pub(crate) fn section_parameters(
     // A sharp end scanned by a rolling ball has many contacts, all noisy estimates of its apex: the farthest of
     // them stands a few microns proud (the trailing edges of the simulated blades read 1-5 um long, +2.7 um on
     // average), their mean does not.
+    // Each end's tip, and whether it is known sharp: the apex of a roll's contacts, or a corner of the outline. An
+    // end with no circle found that is neither (a round nose scanned too sparsely for its circle) is not.
     let to_tip = |end: Vector2<f64>, circle: Option<&Circle>, outward: Vector2<f64>| match circle {
-        Some(circle) => round_tip(outline, end, outward, circle.radius)
-            .unwrap_or_else(|| end + outward * smooth_reach_beyond(outline, end, outward)),
-        None => sharp_tip(outline, sharp_edge_contacts, end),
+        Some(circle) => (
+            round_tip(outline, end, outward, circle.radius)
+                .unwrap_or_else(|| end + outward * smooth_reach_beyond(outline, end, outward)),
+            false,
+        ),
+        None => match roll_apex(outline, sharp_edge_contacts, end) {
+            Some(apex) => (apex, true),
+            None => (end, is_corner(outline, end, -outward)),
+        },
     };
-    let leading_edge = to_tip(leading_edge, le_circle.as_ref(), -inward);
-    let trailing_edge = to_tip(trailing_edge, te_circle.as_ref(), inward);
+    let (leading_edge, le_sharp) = to_tip(leading_edge, le_circle.as_ref(), -inward);
+    let (trailing_edge, te_sharp) = to_tip(trailing_edge, te_circle.as_ref(), inward);
     let chord_mm = (trailing_edge - leading_edge).norm();
     let across = Across::new(outline, leading_edge, trailing_edge);
     let le_thickness_mm = across.thickness_at(edge_distance_mm)?;
@@ -247,8 +255,8 @@ pub(crate) fn section_parameters(
     // A sharp end is the mean line's end itself (a NACA section's closed trailing edge is where its mean line
     // ends); a round one's end is found by following the mean line out.
     let sharp_ends = [
-        le_circle.is_none().then_some(leading_edge),
-        te_circle.is_none().then_some(trailing_edge),
+        le_sharp.then_some(leading_edge),
+        te_sharp.then_some(trailing_edge),
     ];
     let mean_line = MeanLine::of(&across, chord_mm, sharp_ends)?;
     Ok(SectionParameters {
@@ -653,22 +661,55 @@ fn smooth_reach_beyond(outline: &[Vector2<f64>], end: Vector2<f64>, outward: Vec
         .fold(0.0, f64::max)
 }
 
-/// A sharp end's tip: the mean of the contacts rolling round it (those of `sharp_edge_contacts` within
-/// [`SHARP_TIP_REACH_MM`] of its farthest point `end`), or `end` itself where there are fewer than two.
-fn sharp_tip(
+/// A sharp end's apex: the mean of the contacts rolling round it (those of `sharp_edge_contacts` within
+/// [`SHARP_TIP_REACH_MM`] of its farthest point `end`); `None` where there are fewer than two.
+fn roll_apex(
     outline: &[Vector2<f64>],
     sharp_edge_contacts: &[usize],
     end: Vector2<f64>,
-) -> Vector2<f64> {
+) -> Option<Vector2<f64>> {
     let near: Vec<Vector2<f64>> = sharp_edge_contacts
         .iter()
         .map(|&i| outline[i])
         .filter(|p| (p - end).norm() <= SHARP_TIP_REACH_MM)
         .collect();
-    if near.len() < 2 {
-        return end;
-    }
-    near.iter().sum::<Vector2<f64>>() / near.len() as f64
+    (near.len() >= 2).then(|| near.iter().sum::<Vector2<f64>>() / near.len() as f64)
+}
+
+/// How far along the outline from an end its direction shows whether the end is a corner (mm): past a sharp
+/// edge's rounding and a roll's scatter, within a round nose's first few degrees of turn (0.5 / r rad).
+const CORNER_REACH_MM: f64 = 0.5;
+/// A corner's faces leave it within this angle of the way into the section (deg); a round nose's outline, as far
+/// along it, leaves at 90 deg less half its turn (over 75 deg for a radius over 1 mm).
+const CORNER_MAX_DEG: f64 = 45.0;
+
+/// Whether the outline has a corner at its point `tip`, the section lying towards `inward` (unit): both ways round
+/// the outline, its point [`CORNER_REACH_MM`] along it from the tip lies within [`CORNER_MAX_DEG`] of `inward`
+/// (the polyline's own points, however sparse, or a point on a segment between them).
+fn is_corner(outline: &[Vector2<f64>], tip: Vector2<f64>, inward: Vector2<f64>) -> bool {
+    let n = outline.len();
+    let Some(start) = outline.iter().position(|p| *p == tip) else {
+        return false;
+    };
+    let cos_max = CORNER_MAX_DEG.to_radians().cos();
+    let along = |step: usize| {
+        let (mut at, mut travelled) = (start, 0.0);
+        for _ in 0..n {
+            let next = (at + step) % n;
+            let segment = outline[next] - outline[at];
+            let length = segment.norm();
+            if length > 0.0 && travelled + length >= CORNER_REACH_MM {
+                return outline[at] + segment * ((CORNER_REACH_MM - travelled) / length);
+            }
+            travelled += length;
+            at = next;
+        }
+        outline[at]
+    };
+    [1, n - 1].into_iter().all(|step| {
+        let d = along(step) - tip;
+        d.dot(&inward) >= cos_max * d.norm() && d.norm() > 0.0
+    })
 }
 
 /// The root in [0, 1] of `f`, which is `f0` at 0 and `f1` at 1, of opposite signs (or one of them zero), by

@@ -89,7 +89,8 @@ fn published_profile_3_refitted_from_noisy_points_lies_within_5_um() {
 }
 
 /// Points about `step` mm apart along the zero-set curve through (the projection of) `start`, both ways from it,
-/// each way until the curve leaves `within`: an open arc of an unbounded curve, from one end to the other.
+/// each way until the curve leaves `within` (at most a million steps each way): an open arc of an unbounded curve,
+/// from one end to the other.
 fn trace_arc(
     model: &IpModel<2>,
     start: &Vector2<f64>,
@@ -100,7 +101,7 @@ fn trace_arc(
     let mut halves = [vec![], vec![]];
     for (half, way) in halves.iter_mut().zip([1.0, -1.0]) {
         let mut current = first;
-        loop {
+        for _ in 0..1_000_000 {
             let (_, g) = model.value_gradient(&current);
             let ahead = current + Vector2::new(-g.y, g.x).normalize() * (way * step);
             let next = project_to_zero_set(model, &ahead, step).expect("the arc is smooth");

@@ -548,3 +548,41 @@ fn a_sharp_trailing_edge_s_apex_is_the_mean_line_s_end_and_steadies_the_chord_an
         "RMS {rms} deg, worst {worst} deg: {errors:?}"
     );
 }
+
+#[test]
+fn a_round_nose_too_sparse_for_its_circle_is_not_taken_for_a_sharp_end() {
+    // NACA 4412 of 150 mm (nose radius 2.4 mm) with a point only every 1.5 mm or 40 deg of turn: too few round the
+    // nose for its circle, so no radius is read there. Its farthest point is not a corner: the mean line is still
+    // followed out to the nose (its end 0.47 mm across the chord from the farthest point, which as the end would
+    // turn the chord angle by 0.18 deg).
+    let dense = naca_4412_of_150_mm();
+    let truth = section_parameters(&dense, &[], 2.0).unwrap();
+    for phase in [0.0, 0.25, 0.5, 0.75] {
+        let scan = stepped_by(&dense, 1.5, phase, 40.0);
+        let p = section_parameters(&scan, &[], 2.0).unwrap();
+        assert_eq!(
+            p.le_radius_mm, None,
+            "phase {phase}: too sparse for a circle"
+        );
+        assert_ne!(p.mean_line.leading_end, p.leading_edge, "phase {phase}");
+        let error = p.mean_line.chord_angle_deg - truth.mean_line.chord_angle_deg;
+        assert!(
+            error.abs() < 0.01,
+            "phase {phase}: chord angle off by {error} deg"
+        );
+    }
+    // The trailing edge is a corner however far apart the points beside it lie (a nominal outline thinned where it
+    // is straight): the line ends there.
+    let thinned: Vec<Vector2<f64>> = std::iter::once(dense[0])
+        .chain(
+            stepped_by(&dense, 0.5, 0.0, 5.0)
+                .into_iter()
+                .filter(|p| (p - dense[0]).norm() > 3.0),
+        )
+        .collect();
+    let n = thinned.len();
+    assert!((thinned[1] - thinned[0]).norm() > 3.0 && (thinned[n - 1] - thinned[0]).norm() > 3.0);
+    let p = section_parameters(&thinned, &[], 2.0).unwrap();
+    assert_eq!(p.trailing_edge, dense[0]);
+    assert_eq!(p.mean_line.trailing_end, p.trailing_edge);
+}
