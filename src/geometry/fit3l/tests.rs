@@ -125,7 +125,8 @@ fn trace_arc(
 fn seed_003_s_published_profiles_refitted_from_20_noise_draws_lie_within_2_um_of_them() {
     // What `zeroset fit ip` does by default with 400 points of each published quartic, 2 um of noise along the
     // normal, over 20 draws: the degree chosen by the points held out of the fit, 3L refined by orthogonal
-    // distances, ordered normals. Profiles 3 and 5 are the closed sections of their zero sets; profile 1's quartic
+    // distances, ordered normals (each fit clean, so `fit ip` would keep it rather than fall back to another
+    // degree). Profiles 3 and 5 are the closed sections of their zero sets; profile 1's quartic
     // opens out beyond its nose, so its points are the open arc from z = 250 mm on one face round the nose to
     // z = 250 mm on the other (profile 3's section reaches z = 324 mm).
     let section = |number: u8, start: Vector2<f64>| {
@@ -165,6 +166,16 @@ fn seed_003_s_published_profiles_refitted_from_20_noise_draws_lie_within_2_um_of
                 &FitOptions::new(degree, FitMethod::default()),
             )
             .unwrap();
+            let s = &fitted.stats;
+            assert_eq!(
+                (
+                    s.branches_beside_data,
+                    s.side_segments_crossed_again,
+                    s.points_without_foot
+                ),
+                (0, 0, 0),
+                "profile {number}, draw {draw}: a defect"
+            );
             let (max, rms, at) = deviation_from(&fitted, dense);
             // The fit's error is the noise's, averaged over the points: its RMS along the curve is a fraction
             // of the noise; its largest lies where the points are fewest for the curve's bending.
