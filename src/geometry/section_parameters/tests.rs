@@ -586,3 +586,46 @@ fn a_round_nose_too_sparse_for_its_circle_is_not_taken_for_a_sharp_end() {
     assert_eq!(p.trailing_edge, dense[0]);
     assert_eq!(p.mean_line.trailing_end, p.trailing_edge);
 }
+
+#[test]
+fn a_noisy_scan_s_trailing_edge_thickness_is_read_from_its_faces_fitted_not_from_two_points() {
+    // NACA 4412, 0012 and 6409 of 150 mm, scanned every 1 mm and 2.5 deg round the nose from a random phase with
+    // 2 um of noise, the ball's 16 contacts rolling round the trailing edge named; 30 draws each. The thickness 2 mm
+    // in from the trailing edge, against the dense outline's: each face crossed through the two points beside the
+    // line carried their noise (2.6-2.7 um RMS, up to 7.6 um over 100 draws); each face's quadratic over the points
+    // within 5 mm of the line averages it (1.4-1.5 um RMS, 4.1 um at worst over 100 draws). The leading-edge
+    // thickness, where the face turns too fast for the quadratic, is read as before, as unbiased.
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(77);
+    let (mut trailing, mut leading) = (Vec::new(), Vec::new());
+    for digits in ["4412", "0012", "6409"] {
+        let dense: Vec<Vector2<f64>> = Naca4::from_digits(digits, 150.0, true)
+            .unwrap()
+            .points(30000)
+            .into_iter()
+            .map(|[x, y]| Vector2::new(x, y))
+            .collect();
+        let truth = section_parameters(&dense, &[], 2.0).unwrap();
+        for _ in 0..30 {
+            let scan = noisy(&stepped_by(&dense, 1.0, rng.gen(), 2.5), 0.002, rng.gen());
+            let (outline, contacts) = with_roll_contacts(&scan, dense[0], &mut rng);
+            let measured = section_parameters(&outline, &contacts, 2.0).unwrap();
+            trailing.push(measured.te_thickness_mm - truth.te_thickness_mm);
+            leading.push(measured.le_thickness_mm - truth.le_thickness_mm);
+        }
+    }
+    let rms = |v: &[f64]| (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    assert!(
+        rms(&trailing) < 0.0018 && worst(&trailing) < 0.005,
+        "trailing edge: RMS {} mm, worst {} mm",
+        rms(&trailing),
+        worst(&trailing)
+    );
+    assert!(
+        mean(&leading).abs() < 0.001,
+        "leading edge: mean {} mm",
+        mean(&leading)
+    );
+}
