@@ -488,6 +488,14 @@ pub(crate) fn farthest_pair(points: &[Vector2<f64>]) -> (Vector2<f64>, Vector2<f
     (best.1, best.2)
 }
 
+/// Where a station's line crosses the outline: the index of the point starting the outline's segment it crosses,
+/// and its offset from the chord there (mm).
+#[derive(Clone, Copy)]
+struct Crossing {
+    segment: usize,
+    offset: f64,
+}
+
 /// Lines across the section, perpendicular to its chord, at stations measured from the leading edge.
 struct Across<'a> {
     outline: &'a [Vector2<f64>],
@@ -519,13 +527,22 @@ impl<'a> Across<'a> {
 
     /// The outermost offsets (from the chord) at which the station's line meets the outline.
     fn faces_at(&self, s: f64) -> Result<(f64, f64), ParameterError> {
-        self.crossings_at(s).map(|(low, high)| (low.1, high.1))
+        self.crossings_at(s)
+            .map(|(low, high)| (low.offset, high.offset))
     }
 
-    /// The outermost crossings of the station's line with the outline, each as the index of the point starting
-    /// the outline's segment it crosses and its offset from the chord, lower first.
-    fn crossings_at(&self, s: f64) -> Result<((usize, f64), (usize, f64)), ParameterError> {
-        let (mut low, mut high) = ((0, f64::INFINITY), (0, f64::NEG_INFINITY));
+    /// The outermost crossings of the station's line with the outline, lower first.
+    fn crossings_at(&self, s: f64) -> Result<(Crossing, Crossing), ParameterError> {
+        let (mut low, mut high) = (
+            Crossing {
+                segment: 0,
+                offset: f64::INFINITY,
+            },
+            Crossing {
+                segment: 0,
+                offset: f64::NEG_INFINITY,
+            },
+        );
         let n = self.outline.len();
         for i in 0..n {
             let p = self.outline[i] - self.origin;
@@ -544,15 +561,18 @@ impl<'a> Across<'a> {
                 }
                 None => p + (q - p) * (sp / (sp - sq)),
             };
-            let offset = crossing.dot(&self.normal);
-            if offset < low.1 {
-                low = (i, offset);
+            let here = Crossing {
+                segment: i,
+                offset: crossing.dot(&self.normal),
+            };
+            if here.offset < low.offset {
+                low = here;
             }
-            if offset > high.1 {
-                high = (i, offset);
+            if here.offset > high.offset {
+                high = here;
             }
         }
-        if low.1 < high.1 {
+        if low.offset < high.offset {
             Ok((low, high))
         } else {
             Err(ParameterError::OpenAt(s))
@@ -563,7 +583,10 @@ impl<'a> Across<'a> {
     /// about the line crosses it (see [`Across::face_offset`]).
     fn thickness_at(&self, s: f64) -> Result<f64, ParameterError> {
         let (low, high) = self.crossings_at(s)?;
-        let face = |(i, offset): (usize, f64)| self.face_offset(i, s).unwrap_or(offset);
+        let face = |crossing: Crossing| {
+            self.face_offset(crossing.segment, s)
+                .unwrap_or(crossing.offset)
+        };
         Ok(face(high) - face(low))
     }
 
