@@ -99,6 +99,54 @@ pub fn read_point_file(path: &Path) -> Result<PointFile, PointFileError> {
     Ok(PointFile { points, lines })
 }
 
+/// The column that names a section's points that are contacts of the ball rolling round a sharp edge (1; 0 for
+/// the others): the station takes their mean for the edge's apex.
+pub const ROLL_COLUMN: &str = "roll";
+
+/// One measured section: its (y, z) points in order round it, and which of them are contacts of the ball rolling
+/// round a sharp edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionPoints {
+    pub points: Vec<Vector2<f64>>,
+    /// Indices into `points`.
+    pub roll_contacts: Vec<usize>,
+}
+
+/// Reads a section, `y,z` (no roll contacts named) or `y,z,roll` (as the station writes each section of a report
+/// under `sections/`).
+pub fn read_section(path: &Path) -> Result<SectionPoints, PointFileError> {
+    let table = read_table(path, |header| {
+        match header {
+        ["y", "z"] | ["y", "z", ROLL_COLUMN] => Ok(()),
+        ["x", "y", "z"] => Err("this file has x,y,z; a section is y,z points in its plane".into()),
+        _ => Err(format!(
+            "header '{}' (expected y,z or y,z,{ROLL_COLUMN}: a section's points in mm, and 1 where a point is a \
+             contact of the ball rolling round a sharp edge)",
+            header.join(",")
+        )),
+    }
+    })?;
+    let mut section = SectionPoints {
+        points: Vec::with_capacity(table.rows.len()),
+        roll_contacts: Vec::new(),
+    };
+    for (index, (line, record)) in table.rows.iter().enumerate() {
+        let yz = table.coordinates(*line, record, 2)?;
+        section.points.push(Vector2::new(yz[0], yz[1]));
+        match record.get(2) {
+            None | Some("0") => {}
+            Some("1") => section.roll_contacts.push(index),
+            Some(other) => {
+                return Err(table.error(
+                    *line,
+                    format!("column {ROLL_COLUMN}: '{other}' is neither 0 nor 1"),
+                ))
+            }
+        }
+    }
+    Ok(section)
+}
+
 /// The column that names the segment of a part a point belongs to (seed 001 section 6.3: a segmented scan).
 pub const SEGMENT_COLUMN: &str = "segment";
 
@@ -366,5 +414,32 @@ mod tests {
         assert!(segments("y,z\n1,2\n")
             .unwrap_err()
             .ends_with("y,z is a planar profile, and this needs points over a part's surface)"));
+    }
+
+    #[test]
+    fn a_section_names_its_roll_contacts_by_their_place_in_the_file() {
+        let section = |text: &str| {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("section.csv");
+            std::fs::write(&path, text).unwrap();
+            read_section(&path).map_err(|e| {
+                e.to_string()
+                    .replace(&dir.path().display().to_string(), "DIR")
+            })
+        };
+        let read = section("y,z,roll\n1,2,0\n3,4,1\n5,6,1\n7,8,0\n").unwrap();
+        assert_eq!(read.points[2], Vector2::new(5.0, 6.0));
+        assert_eq!(read.roll_contacts, vec![1, 2]);
+        let plain = section("y,z\n1,2\n3,4\n").unwrap();
+        assert_eq!(plain.points.len(), 2);
+        assert!(plain.roll_contacts.is_empty());
+        assert_eq!(
+            section("y,z,roll\n1,2,0\n3,4,yes\n").unwrap_err(),
+            "DIR/section.csv: line 3: column roll: 'yes' is neither 0 nor 1"
+        );
+        assert_eq!(
+            section("x,y,z\n1,2,3\n").unwrap_err(),
+            "DIR/section.csv: line 1: this file has x,y,z; a section is y,z points in its plane"
+        );
     }
 }

@@ -209,6 +209,36 @@ pub struct SectionFits {
     pub after_l2_mm: Vec<f64>,
 }
 
+/// The signed distance and outward normal at the foot of each of `moved` (the section's points `points`, moved
+/// within its plane by a best fit's trial motion) on `gauge`'s profile, in the plane of each point's own x.
+pub(crate) fn measure_in_plane(
+    gauge: &ProfileGauge,
+    points: &[Point3<f64>],
+    moved: &[Vector2<f64>],
+) -> Vec<Option<Measured>> {
+    let mut scan = gauge.scan();
+    let mut last_normal = None;
+    moved
+        .iter()
+        .zip(points)
+        .map(|(q, p)| {
+            let measured = scan.measure(&Point3::new(p.x, q.x, q.y)).ok()?;
+            let to_point = Vector2::new(q.x - measured.foot[1], q.y - measured.foot[2]);
+            // The distance grows along the line from the foot to the point; at the reference itself (no
+            // line), the neighbour's direction stands in.
+            let normal = match to_point.try_normalize(1e-12) {
+                Some(unit) => unit * measured.deviation_mm.signum(),
+                None => last_normal?,
+            };
+            last_normal = Some(normal);
+            Some(Measured {
+                distance_mm: measured.deviation_mm,
+                normal,
+            })
+        })
+        .collect()
+}
+
 /// The section's fits by least squares and by minimum zone, from its points (part frame, in scan order, flagged
 /// contacts left out), moving what `settings` lets them; `Err` says why the section could not be fitted.
 pub fn best_fits(
@@ -224,29 +254,7 @@ pub fn best_fits(
     }
     let in_plane: Vec<Vector2<f64>> = points.iter().map(|p| Vector2::new(p.y, p.z)).collect();
     let (pivot, chord) = chord_of(&in_plane);
-    let measure = |moved: &[Vector2<f64>]| -> Vec<Option<Measured>> {
-        let mut scan = gauge.scan();
-        let mut last_normal = None;
-        moved
-            .iter()
-            .zip(points)
-            .map(|(q, p)| {
-                let measured = scan.measure(&Point3::new(p.x, q.x, q.y)).ok()?;
-                let to_point = Vector2::new(q.x - measured.foot[1], q.y - measured.foot[2]);
-                // The distance grows along the line from the foot to the point; at the reference itself (no
-                // line), the neighbour's direction stands in.
-                let normal = match to_point.try_normalize(1e-12) {
-                    Some(unit) => unit * measured.deviation_mm.signum(),
-                    None => last_normal?,
-                };
-                last_normal = Some(normal);
-                Some(Measured {
-                    distance_mm: measured.deviation_mm,
-                    normal,
-                })
-            })
-            .collect()
-    };
+    let measure = |moved: &[Vector2<f64>]| measure_in_plane(gauge, points, moved);
     let mut after_l2_mm = Vec::new();
     let fits = [(FitMethod::L2, "l2"), (FitMethod::MinZone, "minzone")]
         .into_iter()

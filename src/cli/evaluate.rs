@@ -2,15 +2,17 @@
 //! once that is removed, by a least-squares or minimum-zone best fit in the section's plane; and the section's
 //! parameters (chord, maximum and edge thicknesses) measured and nominal.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail};
 use clap::{Args, ValueEnum};
-use nalgebra::Vector2;
+use nalgebra::{Point3, Vector2};
 
+use crate::analysis::deviation::ProfileGauge;
+use crate::analysis::reference::Reference;
 use crate::analysis::section::{
-    chord_of, faces_outline, nominal_outline, BestFitLimits, BestFitMode, BestFitSettings,
-    EDGE_DISTANCE_MM,
+    chord_of, faces_outline, measure_in_plane, nominal_outline, BestFitLimits, BestFitMode,
+    BestFitSettings, EDGE_DISTANCE_MM,
 };
 use crate::fsutil::write_atomically;
 use crate::geometry::distance::ExactDistance;
@@ -20,7 +22,7 @@ use crate::geometry::sampling::ZeroSetSamples;
 use crate::geometry::section_fit::{fit_section, FitMethod, Form, Measured, SectionFit};
 use crate::geometry::section_parameters::{section_parameters, SectionParameters};
 use crate::model_file::{FittedIp, ModelFile, ReferenceModel};
-use crate::points::{read_points, PointSet};
+use crate::points::{read_section, SectionPoints};
 
 /// Zero-set sampling for the exact distance's seeds, as `zeroset deviate` does.
 const CELLS: usize = 512;
@@ -28,11 +30,25 @@ const CELLS: usize = 512;
 pub struct EvaluateArgs {
     /// The nominal: a profile model file written by `zeroset fit ip` from y,z points (one polynomial, or faces
     /// joined at sharp edges).
-    #[arg(long)]
-    model: PathBuf,
-    /// The measured section: CSV with header y,z, in mm. A sharp end's tip is its farthest point here: a point file
-    /// does not say which points are contacts of the ball rolling round the edge, whose mean the station takes, so
-    /// a chord read offline may differ from the station's by the noise of one contact (microns).
+    #[arg(
+        long,
+        required_unless_present = "reference",
+        conflicts_with = "reference"
+    )]
+    model: Option<PathBuf>,
+    /// The nominal as the station took it: a taught reference (a report folder's reference.json, or
+    /// references/PART.json in the station's data folder), with --profile naming the section's profile. The
+    /// section is then measured as the station measured it live: against the profile's faces, with the master's
+    /// sharp edges at the apexes of its rolls, and each point in the profile's plane.
+    #[arg(long, requires = "profile")]
+    reference: Option<PathBuf>,
+    /// The reference's profile the section belongs to (e.g. r100).
+    #[arg(long, requires = "reference")]
+    profile: Option<String>,
+    /// The measured section: CSV with header y,z, or y,z,roll, in mm, in order round the section (a report
+    /// folder's sections/INSTANCE-PROFILE.csv holds each section the station evaluated, as it took it). roll is 1
+    /// for a contact of the ball rolling round a sharp edge: a sharp end's tip is their mean, as the station takes
+    /// it; without them, its farthest point, which may lie a contact's noise (microns) off.
     #[arg(long)]
     points: PathBuf,
     /// What the best fit may move before the form is judged.
@@ -54,8 +70,9 @@ pub struct EvaluateArgs {
     /// Each point's deviation as measured and after the fit (CSV), if given.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// How far in from each edge, along the chord, the edge thicknesses are taken (mm).
-    #[arg(long, default_value_t = EDGE_DISTANCE_MM)]
+    /// How far in from each edge, along the chord, the edge thicknesses are taken (mm); a reference's are the
+    /// station's, 2 mm.
+    #[arg(long, default_value_t = EDGE_DISTANCE_MM, conflicts_with = "reference")]
     edge_distance: f64,
 }
 
@@ -78,14 +95,23 @@ enum MethodArg {
 }
 
 pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
-    let file = ModelFile::load(&args.model)?;
-    let nominal = Nominal::of(&file.model).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
-    let PointSet::Profile(points) = read_points(&args.points)? else {
-        bail!(
-            "{}: evaluate needs a section's y,z points; this file has x,y,z",
-            args.points.display()
-        );
+    let (nominal, nominal_name) = match (&args.model, &args.reference, &args.profile) {
+        (Some(model), _, _) => {
+            let file = ModelFile::load(model)?;
+            let nominal =
+                Nominal::of(file.model).map_err(|e| anyhow!("{}: {e}", model.display()))?;
+            (nominal, model.display().to_string())
+        }
+        (None, Some(reference), Some(profile)) => (
+            Nominal::station(reference, profile)?,
+            format!("profile {profile} of {}", reference.display()),
+        ),
+        _ => bail!("evaluate needs --model, or --reference with --profile"),
     };
+    let SectionPoints {
+        points,
+        roll_contacts,
+    } = read_section(&args.points)?;
     let (pivot, chord) = chord_of(&points);
     let (mode, mode_name) = match args.fit {
         FitArg::None => (BestFitMode::None, "no fit"),
@@ -121,19 +147,16 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
          ({:.3}, {:.3}) mm",
         args.points.display(),
         points.len(),
-        args.model.display(),
+        nominal_name,
         pivot.x,
         pivot.y
     )?;
     print_fit(&fitted, &chord, &settings.limits())?;
-    let measured = section_parameters(&points, &[], args.edge_distance)
+    let measured = section_parameters(&points, &roll_contacts, args.edge_distance)
         .map_err(|e| anyhow!("{}: {e}", args.points.display()))?;
     let nominal = nominal
-        .outline(&points)
-        .and_then(|outline| {
-            section_parameters(&outline, &[], args.edge_distance).map_err(|e| e.to_string())
-        })
-        .map_err(|e| anyhow!("{}: {e}", args.model.display()));
+        .parameters(&points, args.edge_distance)
+        .map_err(|e| anyhow!("{nominal_name}: {e}"));
     print_parameters(&measured, nominal, args.edge_distance)?;
     if let Some(out) = &args.out {
         write_deviations(out, &points, &fitted)?;
@@ -143,21 +166,22 @@ pub fn run(args: &EvaluateArgs) -> anyhow::Result<()> {
 }
 
 /// The nominal a section is evaluated against: one polynomial round the profile (with its zero set sampled for the
-/// exact distance's seeds), or its faces.
-enum Nominal<'a> {
+/// exact distance's seeds), its faces, or a profile of the station's taught reference.
+enum Nominal {
     Profile {
-        model: &'a FittedIp<2>,
+        model: Box<FittedIp<2>>,
         samples: ZeroSetSamples<2>,
     },
     Faces(FacedProfile),
+    Station(Box<ProfileGauge>),
 }
 
-impl<'a> Nominal<'a> {
-    fn of(model: &'a ReferenceModel) -> Result<Self, String> {
+impl Nominal {
+    fn of(model: ReferenceModel) -> Result<Self, String> {
         match model {
             ReferenceModel::Profile(model) => Ok(Self::Profile {
-                model,
                 samples: ZeroSetSamples::new(&model.ip, &model.domain.scaled(2.0), CELLS),
+                model: Box::new(model),
             }),
             ReferenceModel::Faces(faced) => {
                 faced.profile().map(Self::Faces).map_err(|e| e.to_string())
@@ -167,6 +191,24 @@ impl<'a> Nominal<'a> {
                     .to_string(),
             ),
         }
+    }
+
+    /// The gauge the station measures the reference's `profile` with.
+    fn station(reference: &Path, profile: &str) -> anyhow::Result<Self> {
+        let taught = Reference::load(reference)?;
+        let names: Vec<String> = taught.profiles.iter().map(|p| p.name.clone()).collect();
+        let gauge = ProfileGauge::all(&taught)
+            .into_iter()
+            .find(|gauge| gauge.name() == profile)
+            .ok_or_else(|| {
+                anyhow!(
+                    "{}: no profile '{profile}' (the reference of part '{}' has {})",
+                    reference.display(),
+                    taught.part,
+                    names.join(", ")
+                )
+            })?;
+        Ok(Self::Station(Box::new(gauge)))
     }
 
     /// The signed distance and outward normal of each point at its foot.
@@ -194,12 +236,24 @@ impl<'a> Nominal<'a> {
                     })
                 })
                 .collect(),
+            Self::Station(gauge) => {
+                let in_plane: Vec<Point3<f64>> = points
+                    .iter()
+                    .map(|p| Point3::new(gauge.x_mm(), p.x, p.y))
+                    .collect();
+                measure_in_plane(gauge, &in_plane, points)
+            }
         }
     }
 
-    /// The nominal outline: a polynomial's zero set along the points' feet, or the faces traced from edge to edge.
-    fn outline(&self, points: &[Vector2<f64>]) -> Result<Vec<Vector2<f64>>, String> {
-        match self {
+    /// The nominal's parameters: those of a polynomial's zero set along the points' feet, of the faces traced from
+    /// edge to edge, or the station's own.
+    fn parameters(
+        &self,
+        points: &[Vector2<f64>],
+        edge_distance_mm: f64,
+    ) -> Result<SectionParameters, String> {
+        let outline = match self {
             Self::Profile { model, samples } => {
                 let exact = ExactDistance::new(&model.ip, samples);
                 points
@@ -207,10 +261,14 @@ impl<'a> Nominal<'a> {
                     .map(|p| exact.foot(p, None).map(|foot| foot.point))
                     .collect::<Result<Vec<_>, _>>()
                     .map(|feet| nominal_outline(&model.ip, &feet))
-                    .map_err(|e| format!("a point has no foot on the model: {e}"))
+                    .map_err(|e| format!("a point has no foot on the model: {e}"))?
             }
-            Self::Faces(faces) => Ok(faces_outline(faces)),
-        }
+            Self::Faces(faces) => faces_outline(faces),
+            Self::Station(gauge) => {
+                return gauge.nominal_parameters().cloned().map_err(String::from)
+            }
+        };
+        section_parameters(&outline, &[], edge_distance_mm).map_err(|e| e.to_string())
     }
 }
 

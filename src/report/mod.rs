@@ -32,7 +32,10 @@ pub use store::{ParameterRecord, ProfileRecord, Store, StoreError, STORE_FILE};
 pub use summary::summary_text;
 pub use trend::{trend, trend_text, TrendRow};
 pub use trend_html::{write_trend_html, TREND_FILE};
-pub use writers::{write_report, DEVIATIONS_FILE, REPORT_FILE, SUMMARY_FILE};
+pub use writers::{
+    write_report, write_sections, DEVIATIONS_FILE, REFERENCE_FILE, REPORT_FILE, SECTIONS_DIR,
+    SUMMARY_FILE,
+};
 
 pub const FORMAT: &str = "zeroset-report";
 pub const VERSION: u32 = 1;

@@ -4,11 +4,16 @@
 use std::path::Path;
 
 use super::{summary_text, PartReport};
+use crate::analysis::section::ScannedSection;
 use crate::fsutil::write_atomically;
 
 pub const REPORT_FILE: &str = "report.json";
 pub const DEVIATIONS_FILE: &str = "deviations.csv";
 pub const SUMMARY_FILE: &str = "summary.txt";
+/// The folder of a report's sections as the station evaluated them, one `INSTANCE-PROFILE.csv` each.
+pub const SECTIONS_DIR: &str = "sections";
+/// The taught reference the report was measured against, copied beside it.
+pub const REFERENCE_FILE: &str = "reference.json";
 
 /// Decimals of the millimetre values in deviations.csv: a nanometre, below any CMM's resolution (report.json
 /// holds every value exactly).
@@ -83,4 +88,34 @@ fn deviations_csv(report: &PartReport) -> Vec<u8> {
             .expect("writing to memory cannot fail");
     }
     writer.into_inner().expect("flushing to memory cannot fail")
+}
+
+/// Writes each section the station evaluated into `dir`/sections/NAME.csv, atomically: `y,z,roll`, the points the
+/// section's best fit and parameters took (compensated, flagged contacts left out, in scan order), in the
+/// profile's plane of the part's frame (mm), with roll 1 for a contact of the ball rolling round a sharp edge.
+/// `zeroset evaluate --reference reference.json --profile PROFILE --points sections/NAME.csv` reads one back and
+/// evaluates it as the station did: the coordinates are written in full (the shortest decimal that reads back as
+/// the same number), so it reads the same values.
+pub fn write_sections(dir: &Path, sections: &[(String, ScannedSection)]) -> std::io::Result<()> {
+    let folder = dir.join(SECTIONS_DIR);
+    std::fs::create_dir_all(&folder).map_err(|e| {
+        std::io::Error::new(e.kind(), format!("cannot create {}: {e}", folder.display()))
+    })?;
+    for (name, section) in sections {
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        writer.write_record(["y", "z", "roll"])?;
+        for (index, point) in section.points.iter().enumerate() {
+            let roll = section.sharp_edge_contacts.contains(&index);
+            writer.write_record([
+                point.y.to_string(),
+                point.z.to_string(),
+                u8::from(roll).to_string(),
+            ])?;
+        }
+        let bytes = writer
+            .into_inner()
+            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        write_atomically(&folder.join(format!("{name}.csv")), &bytes)?;
+    }
+    Ok(())
 }

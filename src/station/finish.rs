@@ -23,8 +23,8 @@ use crate::geometry::supershape::distance::SolidDistance;
 use crate::model_file::{ReferenceModel, SolidFitStats};
 use crate::plan::Plan;
 use crate::report::{
-    write_html, write_qif, write_report, ClassUse, InstanceReport, MachineUse, PartReport,
-    PointRecord, ProfileReport, ReferenceUse, Store,
+    write_html, write_qif, write_report, write_sections, ClassUse, InstanceReport, MachineUse,
+    PartReport, PointRecord, ProfileReport, ReferenceUse, Store, REFERENCE_FILE,
 };
 
 /// How a finished job ended.
@@ -181,6 +181,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
     let mut machines: BTreeMap<String, MachineUse> = BTreeMap::new();
     let mut instances: Vec<InstanceReport> = Vec::new();
     let tolerances = plan.tolerance().parameter_tolerances();
+    let mut sections = Vec::new();
     for (instance, name) in plan.instance_names().iter().enumerate() {
         let mut profiles = Vec::new();
         let mut all = RunningStats::default();
@@ -282,6 +283,7 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
                     tracing::warn!(scan = %plan.describe(key), %problem, "report: no parameters of the section");
                 })
                 .ok();
+            sections.push((file_stem(&scan_name), in_part));
             let (parameters, distribution) = match shape {
                 Some(shape) => (Some(shape.parameters), Some(shape.distribution)),
                 None => (None, None),
@@ -385,6 +387,8 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
     write_html(&folder, &report).map_err(|e| e.to_string())?;
     write_qif(&folder, &report).map_err(|e| e.to_string())?;
+    write_sections(&folder, &sections).map_err(|e| e.to_string())?;
+    copy_reference(inputs.reference_path, &folder).map_err(|e| e.to_string())?;
     write_report(&folder, &report).map_err(|e| e.to_string())?;
     copy_scans(dir, &folder).map_err(|e| e.to_string())?;
     // Last: once the history holds the inspection, it is done (the daemon then closes its journal; a daemon killed
@@ -406,6 +410,18 @@ pub fn write_inspection(inputs: &ReportInputs) -> Result<Outcome, String> {
         instances: summaries,
         verdict,
     })
+}
+
+/// The reference goes with the report, so that its sections can be evaluated again as the station did after the
+/// part is taught again.
+fn copy_reference(reference: &Path, folder: &Path) -> std::io::Result<()> {
+    let bytes = std::fs::read(reference).map_err(|e| {
+        std::io::Error::new(
+            e.kind(),
+            format!("cannot read the reference {}: {e}", reference.display()),
+        )
+    })?;
+    crate::fsutil::write_atomically(&folder.join(REFERENCE_FILE), &bytes)
 }
 
 /// The raw scans go with the report, so that it can be analysed again without the daemon's data folder.

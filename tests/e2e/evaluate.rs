@@ -8,7 +8,7 @@ use zeroset_sim::naca::Naca4;
 use crate::support::{config, fit_ip, naca_csv, zeroset, zeroset_ok};
 
 /// The numbers of `line` after `marker`, up to `count`.
-fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
+pub(crate) fn numbers_after(printed: &str, marker: &str, count: usize) -> Vec<f64> {
     let line = printed
         .lines()
         .find(|l| l.contains(marker))

@@ -15,6 +15,7 @@ use zeroset_sim::part::propeller::PropellerSpec;
 
 use crate::blade_errors::{assert_parameters_read_the_injected_errors, injected};
 use crate::daemon::{job_over, Station, A_JOB_S};
+use crate::evaluate::numbers_after;
 use crate::sim::{propeller, propeller_spec};
 use crate::support::propeller_part_edited;
 
@@ -382,6 +383,27 @@ fn teach_and_inspect_measure_the_simulated_blade_errors() {
         "{out}"
     );
     assert_qif_valid(&dir.join("report.qif"));
+    for (blade, profile) in [(1, 0), (2, 4)] {
+        assert_a_section_evaluates_offline_as_it_did_live(&dir, &report, blade, profile);
+    }
+    let wrong = crate::support::zeroset(&[
+        "evaluate",
+        "--reference",
+        dir.join("reference.json").to_str().unwrap(),
+        "--profile",
+        "r150",
+        "--points",
+        dir.join("sections").join("B-r100.csv").to_str().unwrap(),
+    ]);
+    assert!(
+        !wrong.success
+            && wrong.stderr.contains(
+                "reference.json: no profile 'r150' (the reference of part 'propeller' has r100, r200, r300, \
+                 r400, r500)"
+            ),
+        "{}",
+        wrong.stderr
+    );
     if let Some(dom) = render_in_a_browser(&dir.join("report.html")) {
         assert_eq!(
             dom.matches("<svg").count(),
@@ -1023,4 +1045,68 @@ fn a_best_fit_limit_in_the_part_file_holds_the_section_fits_and_says_so() {
         watched.contains("(the fit held at its limit dn +-0.5 mm; the rest is in the form)"),
         "{watched}"
     );
+}
+
+/// `zeroset evaluate` on a section of the report folder `dir` (its sections/INSTANCE-PROFILE.csv against the copy
+/// of the reference beside it) prints the least-squares best fit and the parameters the station reported live
+/// for it, to the printed 0.1 um and 0.1 mdeg: the same points, the roll's contacts named, the same nominal.
+fn assert_a_section_evaluates_offline_as_it_did_live(
+    dir: &std::path::Path,
+    report: &PartReport,
+    blade: usize,
+    profile: usize,
+) {
+    let (instance, section) = (
+        &report.instances[blade],
+        &report.instances[blade].profiles[profile],
+    );
+    let what = format!("{} {}", instance.name, section.name);
+    let points = dir
+        .join("sections")
+        .join(format!("{}-{}.csv", instance.name, section.name));
+    let text = std::fs::read_to_string(&points).unwrap_or_else(|e| panic!("{points:?}: {e}"));
+    let rolls = text.lines().skip(1).filter(|l| l.ends_with(",1")).count();
+    assert!(
+        rolls >= 2,
+        "{what}: the roll round the trailing edge in {points:?}: {rolls} contacts"
+    );
+    let printed = crate::support::zeroset_ok(&[
+        "evaluate",
+        "--reference",
+        dir.join("reference.json").to_str().unwrap(),
+        "--profile",
+        &section.name,
+        "--points",
+        points.to_str().unwrap(),
+    ]);
+    // Printed to 4 decimals: within half of the last.
+    let close = |read: f64, live: f64, name: &str| {
+        assert!(
+            (read - live).abs() <= 0.51e-4,
+            "{what}: {name} printed {read}, live {live}:\n{printed}"
+        )
+    };
+    let l2 = section
+        .best_fits
+        .iter()
+        .find(|fit| fit.method == "l2")
+        .unwrap_or_else(|| panic!("{what}: no least-squares fit"));
+    let lies = numbers_after(&printed, "the section lies", 3);
+    close(lies[0], l2.dn_mm, "dn");
+    close(lies[1], l2.dchord_mm, "dchord");
+    close(lies[2], l2.rotation_deg, "rotation");
+    let live = section.parameters.as_ref().expect("parameters");
+    for (row, value) in [
+        ("chord (mm)", &live.chord_mm),
+        ("max thickness, inscribed (mm)", &live.max_thickness_mm),
+        ("leading-edge thickness (mm)", &live.le_thickness_mm),
+        ("trailing-edge thickness (mm)", &live.te_thickness_mm),
+        ("max camber, mean line (mm)", &live.max_camber_mm),
+        ("chord angle to +y (deg)", &live.chord_angle_deg),
+    ] {
+        let read = numbers_after(&printed, row, 3);
+        close(read[0], value.measured, row);
+        close(read[1], value.nominal, row);
+        close(read[2], value.deviation, row);
+    }
 }
