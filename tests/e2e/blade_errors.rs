@@ -95,6 +95,9 @@ pub fn assert_parameters_read_the_injected_errors(
             // included, while the faces were crossed along the chords between the scan's points (up to 1 mm apart
             // round the nose); along the smooth outline through them it reads within 6.7 um on propeller.toml and
             // 14.3 um on the shape errors (C r200, whose camber +2.6 % also turns the nose), and is held to 20 um.
+            // With each face read from a quadratic over its points where it is nearly straight, the trailing-edge
+            // thickness reads within 4.9 um on both files over eight and four seeds (8.4 um through the two points
+            // beside the line): it is held to 8 um.
             let checks = [
                 (
                     "max thickness",
@@ -124,7 +127,7 @@ pub fn assert_parameters_read_the_injected_errors(
                     "trailing-edge thickness",
                     p.te_thickness_mm.deviation,
                     edge(p.te_thickness_mm.nominal),
-                    0.015,
+                    0.008,
                 ),
                 (
                     "chord",
