@@ -90,6 +90,11 @@ const FACE_FIT_MIN_REACH_MM: f64 = 0.5;
 const FACE_FIT_MAX_TURN_DEG: f64 = 3.0;
 /// ... from at least this many points (else the smooth outline through the points is crossed).
 const FACE_FIT_MIN_POINTS: usize = 5;
+/// The spacing of the smooth outline an edge's circle is fitted to, mm: fine enough that the zone's cut moves a NACA
+/// nose's circle by under 0.3 um (5 um spacing: 0.7 um).
+const SMOOTH_SPACING_MM: f64 = 0.002;
+/// Steps along each segment per spacing, between which its points are placed.
+const SMOOTH_STEPS_PER_SPACING: usize = 4;
 /// Fits by which the zone is settled.
 const EDGE_ZONE_ROUNDS: usize = 3;
 /// Points at least, for an edge's circle.
@@ -148,6 +153,47 @@ pub struct MeanLine {
     /// The chord line's direction, leading to trailing end, from the outline's first axis towards its second
     /// (deg, in (-180, 180]).
     pub chord_angle_deg: f64,
+}
+
+/// The smooth outline through `outline`'s points (its Catmull-Rom segments, chords where points coincide) sampled
+/// every [`SMOOTH_SPACING_MM`] or so along it, on each segment that has a point within `zone` of `depth`.
+fn smooth_outline_within(
+    outline: &[Vector2<f64>],
+    zone: f64,
+    depth: impl Fn(&Vector2<f64>) -> f64,
+) -> Vec<Vector2<f64>> {
+    let n = outline.len();
+    let mut smooth: Vec<Vector2<f64>> = Vec::new();
+    // Points every spacing of the way along the outline, each stretch then weighing by its length however the
+    // outline's own points crowd (a dense outline's round a nose, a scan's 2.5-deg steps): placed between fine
+    // steps along each segment, `to_next` ahead of the last.
+    let mut to_next = 0.0;
+    for i in 0..n {
+        let (a, b) = (outline[i], outline[(i + 1) % n]);
+        if depth(&a) > zone && depth(&b) > zone {
+            to_next = 0.0;
+            continue;
+        }
+        let steps = ((b - a).norm() * SMOOTH_STEPS_PER_SPACING as f64 / SMOOTH_SPACING_MM)
+            .ceil()
+            .max(1.0) as usize;
+        let segment = CatmullRom::through(outline, i);
+        let at = |t: f64| segment.as_ref().map_or(a + (b - a) * t, |s| s.at(t));
+        let mut from = a;
+        for k in 1..=steps {
+            let to = at(k as f64 / steps as f64);
+            let length = (to - from).norm();
+            let mut along = 0.0;
+            while to_next <= length - along {
+                along += to_next;
+                smooth.push(from + (to - from) * (along / length));
+                to_next = SMOOTH_SPACING_MM;
+            }
+            to_next -= length - along;
+            from = to;
+        }
+    }
+    smooth
 }
 
 impl MeanLine {
@@ -289,21 +335,29 @@ fn edge_circle(
     inward: Vector2<f64>,
     zone_mm: f64,
 ) -> Option<Circle> {
-    let within = |depth: f64| -> Vec<Vector2<f64>> {
-        outline
+    let depth = |p: &Vector2<f64>| (p - tip).dot(&inward);
+    // The circle is fitted to the smooth outline through the points, sampled evenly along it and cut at the zone's
+    // depth, not to the points themselves: on a nose that is not a circle (a NACA nose's curvature falls away from
+    // the tip), the points a scan happens to put in the zone, and how they crowd, moved the circle. Noise-free NACA
+    // 4412 noses of 150 mm stepped 2.5 deg from random phases read their radius 17 um apart (sd), and 15 um
+    // narrower than their dense outline, through their points; along the smooth outline, 0.6 um apart.
+    let smooth = smooth_outline_within(outline, zone_mm, depth);
+    let within = |zone: f64| -> Vec<Vector2<f64>> {
+        smooth
             .iter()
             .copied()
-            .filter(|p| (p - tip).dot(&inward) <= depth)
+            .filter(|p| depth(p) <= zone)
             .collect()
     };
     // The zone shrinks to its share of the radius found in it; a few rounds settle it.
     let mut circle = fit_circle(&within(zone_mm))?;
     let mut points = Vec::new();
     for _ in 0..EDGE_ZONE_ROUNDS {
-        points = within(zone_mm.min(EDGE_ZONE_DEPTH * circle.radius));
-        if points.len() < EDGE_MIN_POINTS {
+        let zone = zone_mm.min(EDGE_ZONE_DEPTH * circle.radius);
+        if outline.iter().filter(|p| depth(p) <= zone).count() < EDGE_MIN_POINTS {
             return None;
         }
+        points = within(zone);
         circle = fit_circle(&points)?;
     }
     // The span: the points' angles about the centre, from the direction out through the tip.
