@@ -296,14 +296,22 @@ const REACH_MM: f64 = 1e5;
 mod tests {
     use super::*;
 
-    fn read(text: &str) -> Result<PointSet, String> {
+    /// What `reader` makes of `text` written to DIR/points.csv, its error with the folder named DIR.
+    fn read_as<T>(
+        text: &str,
+        reader: impl Fn(&Path) -> Result<T, PointFileError>,
+    ) -> Result<T, String> {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("points.csv");
         std::fs::write(&path, text).unwrap();
-        read_points(&path).map_err(|e| {
+        reader(&path).map_err(|e| {
             e.to_string()
                 .replace(&dir.path().display().to_string(), "DIR")
         })
+    }
+
+    fn read(text: &str) -> Result<PointSet, String> {
+        read_as(text, read_points)
     }
 
     #[test]
@@ -370,13 +378,7 @@ mod tests {
     }
 
     fn segments(text: &str) -> Result<Vec<Segment>, String> {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("points.csv");
-        std::fs::write(&path, text).unwrap();
-        read_segments(&path).map_err(|e| {
-            e.to_string()
-                .replace(&dir.path().display().to_string(), "DIR")
-        })
+        read_as(text, read_segments)
     }
 
     /// Segments come in the order they first appear, each with its points in file order; a file without the
@@ -418,15 +420,7 @@ mod tests {
 
     #[test]
     fn a_section_names_its_roll_contacts_by_their_place_in_the_file() {
-        let section = |text: &str| {
-            let dir = tempfile::tempdir().unwrap();
-            let path = dir.path().join("section.csv");
-            std::fs::write(&path, text).unwrap();
-            read_section(&path).map_err(|e| {
-                e.to_string()
-                    .replace(&dir.path().display().to_string(), "DIR")
-            })
-        };
+        let section = |text: &str| read_as(text, read_section);
         let read = section("y,z,roll\n1,2,0\n3,4,1\n5,6,1\n7,8,0\n").unwrap();
         assert_eq!(read.points[2], Vector2::new(5.0, 6.0));
         assert_eq!(read.roll_contacts, vec![1, 2]);
@@ -435,11 +429,11 @@ mod tests {
         assert!(plain.roll_contacts.is_empty());
         assert_eq!(
             section("y,z,roll\n1,2,0\n3,4,yes\n").unwrap_err(),
-            "DIR/section.csv: line 3: column roll: 'yes' is neither 0 nor 1"
+            "DIR/points.csv: line 3: column roll: 'yes' is neither 0 nor 1"
         );
         assert_eq!(
             section("x,y,z\n1,2,3\n").unwrap_err(),
-            "DIR/section.csv: line 1: this file has x,y,z; a section is y,z points in its plane"
+            "DIR/points.csv: line 1: this file has x,y,z; a section is y,z points in its plane"
         );
     }
 }

@@ -408,12 +408,7 @@ fn a_noisy_scans_maximum_thickness_is_not_read_at_its_luckiest_station() {
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(41);
     for digits in ["4412", "6409"] {
-        let dense: Vec<Vector2<f64>> = Naca4::from_digits(digits, 150.0, true)
-            .unwrap()
-            .points(30000)
-            .into_iter()
-            .map(|[x, y]| Vector2::new(x, y))
-            .collect();
+        let dense = naca_of_150_mm(digits);
         let truth = section_parameters(&dense, &[], 2.0)
             .unwrap()
             .max_thickness_mm;
@@ -434,9 +429,9 @@ fn a_noisy_scans_maximum_thickness_is_not_read_at_its_luckiest_station() {
     }
 }
 
-/// NACA 4412 of 150 mm chord with its trailing edge closed: 30 000 points from the tail.
-fn naca_4412_of_150_mm() -> Vec<Vector2<f64>> {
-    Naca4::from_digits("4412", 150.0, true)
+/// The NACA 4-digit section `digits` of 150 mm chord with its trailing edge closed: 30 000 points from the tail.
+fn naca_of_150_mm(digits: &str) -> Vec<Vector2<f64>> {
+    Naca4::from_digits(digits, 150.0, true)
         .unwrap()
         .points(30000)
         .into_iter()
@@ -468,7 +463,7 @@ fn a_sharp_edges_tip_is_the_mean_of_the_contacts_rolling_round_it() {
     // average).
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(43);
-    let dense = naca_4412_of_150_mm();
+    let dense = naca_of_150_mm("4412");
     let truth = section_parameters(&dense, &[], 2.0).unwrap();
     let along = (truth.trailing_edge - truth.leading_edge).normalize();
     let (mut named, mut farthest) = (Vec::new(), Vec::new());
@@ -523,7 +518,7 @@ fn a_sharp_trailing_edge_s_apex_is_the_mean_line_s_end_and_steadies_the_chord_an
     // the faces' noise.
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(4412);
-    let dense = naca_4412_of_150_mm();
+    let dense = naca_of_150_mm("4412");
     let truth = section_parameters(&dense, &[], 2.0).unwrap();
     assert_eq!(truth.mean_line.trailing_end, truth.trailing_edge);
     let mut errors = Vec::new();
@@ -555,7 +550,7 @@ fn a_round_nose_too_sparse_for_its_circle_is_not_taken_for_a_sharp_end() {
     // nose for its circle, so no radius is read there. Its farthest point is not a corner: the mean line is still
     // followed out to the nose (its end 0.47 mm across the chord from the farthest point, which as the end would
     // turn the chord angle by 0.18 deg).
-    let dense = naca_4412_of_150_mm();
+    let dense = naca_of_150_mm("4412");
     let truth = section_parameters(&dense, &[], 2.0).unwrap();
     for phase in [0.0, 0.25, 0.5, 0.75] {
         let scan = stepped_by(&dense, 1.5, phase, 40.0);
@@ -599,12 +594,7 @@ fn a_noisy_scan_s_trailing_edge_thickness_is_read_from_its_faces_fitted_not_from
     let mut rng = rand::rngs::StdRng::seed_from_u64(77);
     let (mut trailing, mut leading) = (Vec::new(), Vec::new());
     for digits in ["4412", "0012", "6409"] {
-        let dense: Vec<Vector2<f64>> = Naca4::from_digits(digits, 150.0, true)
-            .unwrap()
-            .points(30000)
-            .into_iter()
-            .map(|[x, y]| Vector2::new(x, y))
-            .collect();
+        let dense = naca_of_150_mm(digits);
         let truth = section_parameters(&dense, &[], 2.0).unwrap();
         for _ in 0..30 {
             let scan = noisy(&stepped_by(&dense, 1.0, rng.gen(), 2.5), 0.002, rng.gen());
@@ -641,12 +631,7 @@ fn a_nose_s_radius_does_not_depend_on_where_the_scan_s_points_fall_round_it() {
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
     for digits in ["4412", "6409"] {
-        let dense: Vec<Vector2<f64>> = Naca4::from_digits(digits, 150.0, true)
-            .unwrap()
-            .points(30000)
-            .into_iter()
-            .map(|[x, y]| Vector2::new(x, y))
-            .collect();
+        let dense = naca_of_150_mm(digits);
         let truth = section_parameters(&dense, &[], 2.0)
             .unwrap()
             .le_radius_mm
