@@ -58,21 +58,44 @@ enum GaugeModel {
 impl ProfileGauge {
     /// The gauges of every profile of a taught or loaded reference, in its order.
     pub fn all(reference: &Reference) -> Vec<Self> {
-        let solid = match &reference.model.model {
+        let solid = Self::solid_of(reference);
+        (0..reference.profiles.len())
+            .map(|profile| Self::of_profile(reference, profile, solid.as_ref()))
+            .collect()
+    }
+
+    /// The gauge of the reference's profile named `name` alone, if it has one.
+    pub fn named(reference: &Reference, name: &str) -> Option<Self> {
+        let profile = reference.profiles.iter().position(|p| p.name == name)?;
+        Some(Self::of_profile(
+            reference,
+            profile,
+            Self::solid_of(reference).as_ref(),
+        ))
+    }
+
+    /// The distance to the reference's solid, sampled once for every profile; `None` for a stack of profiles.
+    fn solid_of(reference: &Reference) -> Option<Arc<SolidDistance>> {
+        match &reference.model.model {
             ReferenceModel::Supershape { solid, .. } => Some(Arc::new(SolidDistance::new(solid))),
             _ => None,
-        };
-        (0..reference.profiles.len())
-            .map(|profile| match &solid {
-                Some(distance) => Self {
-                    name: reference.profiles[profile].name.clone(),
-                    x_mm: reference.profiles[profile].x_mm,
-                    model: GaugeModel::Solid(Arc::clone(distance)),
-                    parameters: OnceLock::new(),
-                },
-                None => Self::of_ip_profile(reference, profile),
-            })
-            .collect()
+        }
+    }
+
+    fn of_profile(
+        reference: &Reference,
+        profile: usize,
+        solid: Option<&Arc<SolidDistance>>,
+    ) -> Self {
+        match solid {
+            Some(distance) => Self {
+                name: reference.profiles[profile].name.clone(),
+                x_mm: reference.profiles[profile].x_mm,
+                model: GaugeModel::Solid(Arc::clone(distance)),
+                parameters: OnceLock::new(),
+            },
+            None => Self::of_ip_profile(reference, profile),
+        }
     }
 
     /// The gauge of `reference.profiles[profile]` of an IP stack. Panics when `profile` is out of range or the

@@ -197,17 +197,14 @@ impl Nominal {
     fn station(reference: &Path, profile: &str) -> anyhow::Result<Self> {
         let taught = Reference::load(reference)?;
         let names: Vec<String> = taught.profiles.iter().map(|p| p.name.clone()).collect();
-        let gauge = ProfileGauge::all(&taught)
-            .into_iter()
-            .find(|gauge| gauge.name() == profile)
-            .ok_or_else(|| {
-                anyhow!(
-                    "{}: no profile '{profile}' (the reference of part '{}' has {})",
-                    reference.display(),
-                    taught.part,
-                    names.join(", ")
-                )
-            })?;
+        let gauge = ProfileGauge::named(&taught, profile).ok_or_else(|| {
+            anyhow!(
+                "{}: no profile '{profile}' (the reference of part '{}' has {})",
+                reference.display(),
+                taught.part,
+                names.join(", ")
+            )
+        })?;
         Ok(Self::Station(Box::new(gauge)))
     }
 
