@@ -35,10 +35,17 @@ const MAX_EDGE_RADIUS: f64 = 0.25;
 /// Every centre of a roll lies this many noise sigmas or less from its circle.
 const MAX_SIGMAS: f64 = 4.0;
 
-/// A centre lies on the circle of the run beside it within this many noise sigmas (the circle's own noise added
-/// to the centre's, extrapolated one step). A face's centre within `sqrt(2 x 6 sigma)` of the roll's end along the
-/// face passes, and its contact is taken off the circle: up to 6 sigma proud of the face.
+/// A centre lies on the circle of the run beside it within this many noise sigmas inside it (the circle's own
+/// noise added to the centre's, extrapolated one step) ...
 const PREDICTION_SIGMAS: f64 = 6.0;
+
+/// ... and this many outside it. A face's centre beside the roll stands outside the circle, by `s^2 / 2 r` at `s`
+/// along the face from the roll's end, and the circle refitted through it leans inside the apex by as much: with
+/// 6 sigma either side, a roll's last contacts stood 11 um inside on the simulated propeller's blade C, whose faces
+/// beside its trailing edges were scanned at 0.085 mm, two of their centres within 12 um. A face's centre that
+/// joins now lies within 0.11 mm of the roll's end, and its contact, taken off the circle, 6 um or less off the
+/// apex; a roll's own centre this far out (one in 700) ends its run a centre early.
+const OUTSIDE_SIGMAS: f64 = 3.0;
 
 /// Residuals are allowed at least this much (mm), as for the quartic: noise-free paths fit to round-off.
 const RESIDUAL_FLOOR_MM: f64 = 1e-4;
@@ -59,6 +66,13 @@ const MIN_ROUND_POINTS: usize = 2 * MIN_POINTS - 1;
 /// ... and only over a run that turns through at least this much, rad (80 deg, nine centres at a scan's usual
 /// 10 deg steps).
 const MIN_ROUND_TURN_RAD: f64 = 1.39;
+
+/// A run's edge is round only where its free radius stands this many of its own standard deviations from 0 ...
+const ROUND_SIGNIFICANCE: f64 = 4.0;
+
+/// ... fitted without this many centres at each end of the run, where a face's centre next to the roll may have
+/// joined it.
+const ROUND_TRIM: usize = 1;
 
 /// Gauss-Newton steps of the circle fit, after its algebraic start.
 const FIT_STEPS: usize = 6;
@@ -101,8 +115,12 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
         }
         let sharp = Circle::algebraic(run)?.sharpened(run)?;
         // A round's free radius is no surer than the noise over a short arc, however many centres it has (a roll
-        // in steps of 2 deg over 9 centres read a sharp edge as a 0.1 mm round, and its contacts 10-30 um off).
-        let circle = if run.len() < MIN_ROUND_POINTS || sharp.turn(run).abs() < MIN_ROUND_TURN_RAD {
+        // in steps of 2 deg over 9 centres read a sharp edge as a 0.1 mm round, and its contacts 10-30 um off),
+        // and an edge is taken as round only where its centres say so beyond the noise.
+        let circle = if run.len() < MIN_ROUND_POINTS
+            || sharp.turn(run).abs() < MIN_ROUND_TURN_RAD
+            || !shows_a_round(run, noise_sigma_mm)
+        {
             sharp
         } else {
             Circle::fit(run).filter(|c| c.is_edge(ball))?
@@ -112,11 +130,11 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
     // A centre joins a run only if it lies on the circle of the run without it: a face's centre next to the roll
     // leaves the circle by the square of its distance from the roll's end, which a refit would take in, leaning
     // the circle and every contact taken from it.
+    // A face's centre only ever stands outside the circle: see [`OUTSIDE_SIGMAS`].
     let predicted = |circle: &Circle, centre: &RollSample| {
-        circle.holds(
-            std::slice::from_ref(centre),
-            PREDICTION_SIGMAS / MAX_SIGMAS * tolerance,
-        )
+        let residual = circle.residual(centre);
+        residual >= -PREDICTION_SIGMAS / MAX_SIGMAS * tolerance
+            && residual <= OUTSIDE_SIGMAS / MAX_SIGMAS * tolerance
     };
     // ... of the same kind as the run's: a sharp edge's, or a round one's fitted with its radius.
     let on_circle_of = |kind: &Circle, run: &[RollSample], centre: &RollSample| {
@@ -186,6 +204,33 @@ fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
         && circle.roll_at(run, 0) == Some(None)
         && behind.len() > 2
         && leaves_the_line(behind, &samples[at + 1..], tolerance)
+}
+
+/// Whether a run's centres show a round edge, not a sharp one: the free radius of their circle, fitted without the
+/// run's end centres, is at least [`ROUND_SIGNIFICANCE`] standard deviations (from the centres' noise, `sigma`
+/// mm) from zero.
+///
+/// Why not the free radius itself: over the arc a scan rolls round a blade's trailing edge (80-150 deg), the
+/// radius and the circle's middle along the arc's bisector are nearly the same parameter, so noise of 2 um reads
+/// a sharp edge as a round of 5-25 um with its middle as far inside the apex; and a face's centre within a tenth
+/// of a millimetre of the roll, which may join the run as its end (see [`OUTSIDE_SIGMAS`]), lies outside the
+/// sharp edge's circle and pulls the free radius up by as much again. Taken as rounds, the contacts of the
+/// simulated propeller's sharp trailing edges stood 5-10 um inside their apexes, and the chords read short by
+/// that (blade C r400, 0.5 % short: 5.1 um).
+fn shows_a_round(run: &[RollSample], sigma: f64) -> bool {
+    let inner = &run[ROUND_TRIM..run.len() - ROUND_TRIM];
+    let Some(circle) = Circle::fit(inner) else {
+        return false;
+    };
+    // The radius' variance from the Gauss-Newton normal matrix at the fit: (J^T J)^-1 sigma^2.
+    let normal_matrix = inner.iter().fold(Matrix3::<f64>::zeros(), |m, s| {
+        let unit = (s.centre - circle.middle).normalize();
+        let gradient = Vector3::new(-unit.x, -unit.y, -1.0);
+        m + gradient * gradient.transpose()
+    });
+    normal_matrix.try_inverse().is_some_and(|inverse| {
+        circle.surface_radius.abs() > ROUND_SIGNIFICANCE * sigma * inverse[(2, 2)].sqrt()
+    })
 }
 
 /// Whether any of the centres `ahead` lies farther than `tolerance` from the least-squares line of the centres
@@ -323,9 +368,12 @@ impl Circle {
 
     /// Whether every centre of `run` lies within `tolerance` of the circle.
     fn holds(&self, run: &[RollSample], tolerance: f64) -> bool {
-        run.iter().all(|s| {
-            ((s.centre - self.middle).norm() - s.rho - self.surface_radius).abs() <= tolerance
-        })
+        run.iter().all(|s| self.residual(s).abs() <= tolerance)
+    }
+
+    /// How far the centre lies outside the circle (mm; negative inside).
+    fn residual(&self, s: &RollSample) -> f64 {
+        (s.centre - self.middle).norm() - s.rho - self.surface_radius
     }
 
     /// Whether the circle is an edge's for a ball of in-plane radius `ball`: its surface radius within
