@@ -214,6 +214,29 @@ fn assert_best_fits_recover_the_blade_errors(
     );
 }
 
+/// Blades 1 to 2 % long of chord (B) and 0.5 to 1 % short (C), in their places (config/sims/
+/// propeller-chord-errors.toml): each edge lies up to 1 mm from where the blades' scans were planned on the master,
+/// so their trailing edges are rolled round in steps the plan did not choose. Every section's parameters still read
+/// the simulator's scales back (the chord within the 5 um: B r200 read 6.0 um short while such a roll's
+/// free radius could read its sharp edge as a round), and the run fails on the points alone, 1 mm off the master
+/// at the trailing edges.
+#[test]
+fn inspect_reads_back_chords_longer_and_shorter_than_the_masters() {
+    let station = Station::start("propeller-chord-errors.toml");
+    teach(&station);
+    let run = station.cli(&["inspect", "propeller", "--serial", "SN-3"]);
+    let (_, report) = station.report("SN-3");
+    let spec = propeller_spec("propeller-chord-errors.toml");
+    assert_parameters_read_the_injected_errors(&report, &spec, &station.daemon_log());
+    assert_eq!(run.code, Some(4), "{}\n{}", run.stdout, run.stderr);
+    assert!(
+        run.stderr.starts_with("part propeller serial SN-3: FAIL, ")
+            && run.stderr.contains(" points outside the tolerance"),
+        "{}",
+        run.stderr
+    );
+}
+
 /// Blades of the wrong thickness, chord and camber (config/sims/propeller-shape-errors.toml), in their places:
 /// each section's parameters read the simulator's scales back, and the spacings read 120 deg. Judged by ISO 484
 /// class S (the committed part file's) with the maximum thickness held to +-0.5 % by the part file and every point
