@@ -217,7 +217,7 @@ fn assert_best_fits_recover_the_blade_errors(
 /// Blades 1 to 2 % long of chord (B) and 0.5 to 1 % short (C), in their places (config/sims/
 /// propeller-chord-errors.toml): each edge lies up to 1 mm from where the blades' scans were planned on the master,
 /// so their trailing edges are rolled round in steps the plan did not choose. Every section's parameters still read
-/// the simulator's scales back (the chord within the 5 um: B r200 read 6.0 um short while such a roll's
+/// the simulator's scales back (the chord within the 5 um: C r400 read 5.7 um short while such a roll's
 /// free radius could read its sharp edge as a round), and the run fails on the points alone, 1 mm off the master
 /// at the trailing edges.
 #[test]
