@@ -30,12 +30,13 @@ pub struct Injected {
 }
 
 /// The nose-tail chord of blade `blade`'s section at radius `r` (mm) as the simulator makes it: the farthest
-/// point of its outline from its trailing edge (the outline's parameter 0), over 2^18 points crowded at both
-/// edges, where the farthest is stationary.
+/// point of its outline from its trailing edge (the outline's parameter 0), over 2^16 points crowded at both
+/// edges: 1.3 um apart round a 150 mm section's nose, where the distance is stationary, so that the farthest falls
+/// short of the true chord by far less than a nanometre.
 fn true_chord_mm(propeller: &Propeller, blade: usize, r: f64) -> f64 {
     let section = propeller.section_curve(blade, r);
     let tail = section.point(0.0);
-    const POINTS: u32 = 1 << 18;
+    const POINTS: u32 = 1 << 16;
     (1..POINTS)
         .map(|k| (section.point(f64::from(k) / f64::from(POINTS)) - tail).norm())
         .fold(0.0, f64::max)
