@@ -15,6 +15,7 @@ mod gaps;
 mod job;
 mod journal;
 mod motion;
+mod not_found;
 mod pipeline;
 mod recorder;
 mod verdicts;

@@ -23,6 +23,7 @@ use super::core::Input;
 use super::escape::{check_way_out, extend_by_trail, plan_escape, EscapeModel, ScanPath};
 use super::gaps::find_gap;
 use super::motion::{Scan, ScanMotion};
+use super::not_found::{where_not_found, SURFACE_NOT_FOUND};
 use super::pipeline::PipelineMsg;
 use super::DaemonMsg;
 use crate::analysis::RawPoint;
@@ -774,7 +775,20 @@ impl Worker {
                     if let Scan::InPlane(plan) = &motion.scan {
                         self.follow_trail(reports.as_mut(), trail, plan);
                     }
-                    return Err(error.into());
+                    let mut error = WorkerError::from(error);
+                    if let (
+                        Scan::Curve(plan),
+                        FaultKind::Device {
+                            code: SURFACE_NOT_FOUND,
+                            ..
+                        },
+                    ) = (&motion.scan, error.kind)
+                    {
+                        error
+                            .message
+                            .push_str(&where_not_found(plan, centres.len(), radius));
+                    }
+                    return Err(error);
                 }
             };
             let raw = RawPoint {

@@ -1,0 +1,149 @@
+//! What the operator is told when a scan along the master's curve finds no surface (I++ error 1006, "Surface not
+//! found", spec 11.2.7): where along the curve the machine stopped, and whether scanning again can help.
+//!
+//! Why it matters: the machine's error names neither the point nor the cause, and the usual next step (`zeroset
+//! clear`, which scans the profile again) fails the same way when the cause is the part itself. Round a sharp edge
+//! the master's nominals are one point, the apex, with a fan of normals: each probing line passes through the
+//! master's apex, so it finds the part's edge only within about the ball's radius of it, as do the face normals
+//! just before it. A blade whose trailing edge lies farther inside (a chord 1-2 % short moves each end 0.5-1.8 mm)
+//! or off across the edge stops there.
+
+use zeroset_drivers::machine::{CurveScan, Density};
+
+/// I++ DME 1.4.3, error table: 1006, "Surface not found" (severity 2).
+pub(super) const SURFACE_NOT_FOUND: u16 = 1006;
+
+/// Nominals of a curve scan this close together, mm, are one point of a sharp edge with a fan of normals: where
+/// the ball rolls round the master's edge (the plan's nominals there are the edge's apex; see `plan`).
+const ONE_POINT_MM: f64 = 0.05;
+
+/// The text appended to the machine's "Surface not found" for a curve scan of `scan` that had measured
+/// `measured` points when it stopped, with a ball of `ball_radius_mm`.
+pub(super) fn where_not_found(scan: &CurveScan, measured: usize, ball_radius_mm: f64) -> String {
+    let total = scan.nominals.len();
+    // With one point per nominal, the scan stopped probing the nominal after the last one it measured.
+    if scan.density != Density::AtNominals || measured >= total {
+        return format!(
+            "; no surface was found after {measured} points of the curve's {total} nominals, within {} mm of the \
+             master's surface ([scan] max_deviation_mm) plus the probe's search: check the part's placement \
+             (part_to_machine) and that this is the part the master was taught on",
+            scan.max_deviation
+        );
+    }
+    let nominal = scan.nominals[measured];
+    let (p, n) = (nominal.point, nominal.normal);
+    let along = format!(
+        "; no surface was found after {measured} of {total} points, probing along the normal ({:.3}, {:.3}, {:.3}) \
+         of the master's nominal at ({:.3}, {:.3}, {:.3}) mm",
+        n.x, n.y, n.z, p.x, p.y, p.z
+    );
+    match off_a_sharp_edge(scan, measured) {
+        Some(off) => format!(
+            "{along}, {off:.2} mm from the master's sharp edge (the apex its ball rolls round): the probing lines \
+             beside and round it find the part's edge only within about the ball's radius ({ball_radius_mm} mm) of \
+             the master's, and this part's edge lies farther off (inside it along the chord, a blade short of chord \
+             by about twice that or more, or off across it). Scanning this profile again along the master's curve \
+             stops the same way: check the part against the master; `zeroset abort` ends the job with the scans so \
+             far kept"
+        ),
+        None => format!(
+            "{along}: the part lies farther from the master's surface there than {} mm ([scan] max_deviation_mm) \
+             plus the probe's search. Check the part's placement (part_to_machine) and that this is the part the \
+             master was taught on; scanning it again as it is stops the same way",
+            scan.max_deviation
+        ),
+    }
+}
+
+/// How far nominal `i` lies from the nearest sharp edge's apex (a point the nominals before or after it share, with
+/// a fan of normals), mm, where that is within the scan's `max_deviation`: as far as a part's edge may lie off.
+fn off_a_sharp_edge(scan: &CurveScan, i: usize) -> Option<f64> {
+    let n = scan.nominals.len();
+    let at = |k: usize| {
+        let p = scan.nominals[k].point;
+        nalgebra::Point3::new(p.x, p.y, p.z)
+    };
+    let shares_a_point = |k: usize| {
+        let neighbours = [
+            (k > 0 || scan.closed).then(|| (k + n - 1) % n),
+            (k + 1 < n || scan.closed).then(|| (k + 1) % n),
+        ];
+        neighbours
+            .into_iter()
+            .flatten()
+            .any(|j| j != k && (at(j) - at(k)).norm() < ONE_POINT_MM)
+    };
+    (0..n)
+        .filter(|&k| shares_a_point(k))
+        .map(|k| (at(k) - at(i)).norm())
+        .filter(|&off| off <= scan.max_deviation)
+        .min_by(f64::total_cmp)
+}
+
+#[cfg(test)]
+mod tests {
+    use zeroset_drivers::machine::{Nominal, Xyz};
+
+    use super::*;
+
+    /// A closed curve: a face along y at z = 1 up to an apex at y = 10 with a fan of three normals, then back
+    /// along z = -1.
+    fn blade_end() -> CurveScan {
+        let face = |y: f64, z: f64| Nominal {
+            point: Xyz::new(0.0, y, z),
+            normal: Xyz::new(0.0, 0.0, z.signum()),
+        };
+        let mut nominals: Vec<Nominal> = (0..5).map(|k| face(2.0 * k as f64, 1.0)).collect();
+        let half = std::f64::consts::FRAC_1_SQRT_2;
+        nominals.extend(
+            [(half, half), (1.0, 0.0), (half, -half)].map(|(y, z)| Nominal {
+                point: Xyz::new(0.0, 10.0, 0.0),
+                normal: Xyz::new(0.0, y, z),
+            }),
+        );
+        nominals.extend((0..5).map(|k| face(8.0 - 2.0 * k as f64, -1.0)));
+        CurveScan {
+            closed: true,
+            nominals,
+            max_deviation: 3.0,
+            min_radius: 1.0,
+            density: Density::AtNominals,
+        }
+    }
+
+    #[test]
+    fn a_stop_beside_or_round_a_sharp_edge_says_the_parts_edge_lies_off_the_masters() {
+        let scan = blade_end();
+        // Five face points measured: the sixth nominal, the apex's first normal, found nothing.
+        let text = where_not_found(&scan, 5, 1.0);
+        assert!(
+            text.contains("after 5 of 13 points")
+                && text.contains("(0.000, 0.707, 0.707)")
+                && text
+                    .contains("at (0.000, 10.000, 0.000) mm, 0.00 mm from the master's sharp edge")
+                && text.contains("ball's radius (1 mm)")
+                && text.contains("stops the same way"),
+            "{text}"
+        );
+        // The face points 2.24 mm before the apex, on either face: within the scan's 3 mm of it.
+        assert!(where_not_found(&scan, 4, 1.0).contains(", 2.24 mm from the master's sharp edge"));
+        assert!(where_not_found(&scan, 8, 1.0).contains(", 2.24 mm from the master's sharp edge"));
+    }
+
+    #[test]
+    fn a_stop_on_a_face_says_how_far_the_scan_searched() {
+        let scan = blade_end();
+        // The face point 4.12 mm from the apex.
+        let text = where_not_found(&scan, 3, 1.0);
+        assert!(
+            text.contains("after 3 of 13 points")
+                && text.contains("at (0.000, 6.000, 1.000) mm:")
+                && text.contains("farther from the master's surface there than 3 mm")
+                && !text.contains("sharp edge"),
+            "{text}"
+        );
+        // A scan that measured every nominal and still reported the error: no nominal to name.
+        let text = where_not_found(&scan, 13, 1.0);
+        assert!(text.contains("after 13 points of the curve's 13"), "{text}");
+    }
+}
