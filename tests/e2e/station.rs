@@ -237,6 +237,46 @@ fn inspect_reads_back_chords_longer_and_shorter_than_the_masters() {
     );
 }
 
+/// A blade 2 % short of chord (config/sims/propeller-short-chord.toml): its trailing edges lie 0.9 to 1.8 mm inside
+/// the master's, beyond what a curve scan's roll round the master's sharp edge finds. The inspection stops on the
+/// machine's "Surface not found" at C's first profile, and the operator is told where along the master's curve,
+/// why, and that scanning it again stops the same way.
+#[test]
+fn a_blade_too_short_to_scan_along_the_masters_curve_stops_saying_where_and_why() {
+    let station = Station::start("propeller-short-chord.toml");
+    teach(&station);
+    let run = station.cli(&["inspect", "propeller", "--serial", "SN-4"]);
+    let shown = format!("{}\n{}", run.stdout, run.stderr);
+    assert_eq!(run.code, Some(6), "{shown}");
+    let stopped = shown
+        .lines()
+        .find(|line| line.starts_with("STOPPED: "))
+        .unwrap_or_else(|| panic!("no STOPPED line: {shown}"));
+    for said in [
+        "instance C, profile r100 (x = 100 mm) of part propeller: machine cmm1: ",
+        "error 1006 (severity 2): Surface not found",
+        " mm from the master's sharp edge (the apex its ball rolls round)",
+        "within about the ball's radius (1 mm) of the master's",
+        "Scanning this profile again along the master's curve stops the same way",
+    ] {
+        assert!(stopped.contains(said), "{said:?} not in {stopped}");
+    }
+    // Where: the first nominal the scan could not measure, beside or on the master's trailing edge, at x = 100 mm
+    // in blade C's own frame (C is A turned 240 deg about z).
+    let at = stopped
+        .split("of the master's nominal at (")
+        .nth(1)
+        .and_then(|rest| rest.split(") mm").next())
+        .unwrap_or_else(|| panic!("no nominal in {stopped}"));
+    let xyz: Vec<f64> = at.split(", ").map(|v| v.parse().unwrap()).collect();
+    let (sin, cos) = (-240f64).to_radians().sin_cos();
+    let radial = xyz[0] * cos - xyz[1] * sin;
+    assert!(
+        (radial - 100.0).abs() < 1e-3,
+        "{at}: x {radial} in C's frame"
+    );
+}
+
 /// Blades of the wrong thickness, chord and camber (config/sims/propeller-shape-errors.toml), in their places:
 /// each section's parameters read the simulator's scales back, and the spacings read 120 deg. Judged by ISO 484
 /// class S (the committed part file's) with the maximum thickness held to +-0.5 % by the part file and every point
