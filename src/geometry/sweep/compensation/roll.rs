@@ -130,15 +130,18 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
     // A centre joins a run only if it lies on the circle of the run without it: a face's centre next to the roll
     // leaves the circle by the square of its distance from the roll's end, which a refit would take in, leaning
     // the circle and every contact taken from it.
-    // A face's centre only ever stands outside the circle: see [`OUTSIDE_SIGMAS`].
-    let predicted = |circle: &Circle, centre: &RollSample| {
+    // A face's centre only ever stands outside the circle: see [`OUTSIDE_SIGMAS`]. Both limits allow for a circle
+    // as sure as a centre where it predicts; one less sure (a run bunched over a few degrees) widens them by as
+    // much (see [`Circle::extrapolation`]).
+    let predicted = |circle: &Circle, run: &[RollSample], centre: &RollSample| {
         let residual = circle.residual(centre);
-        residual >= -PREDICTION_SIGMAS / MAX_SIGMAS * tolerance
-            && residual <= OUTSIDE_SIGMAS / MAX_SIGMAS * tolerance
+        let widen = circle.extrapolation(run, centre).max(1.0).sqrt();
+        residual >= -PREDICTION_SIGMAS / MAX_SIGMAS * tolerance * widen
+            && residual <= OUTSIDE_SIGMAS / MAX_SIGMAS * tolerance * widen
     };
     // ... of the same kind as the run's: a sharp edge's, or a round one's fitted with its radius.
     let on_circle_of = |kind: &Circle, run: &[RollSample], centre: &RollSample| {
-        kind.refit(run).is_some_and(|c| predicted(&c, centre))
+        kind.refit(run).is_some_and(|c| predicted(&c, run, centre))
     };
     // The run from a core of centres `start..=end`, reaching back as far as its centres lie on its circle: its
     // length and what it makes of the point.
@@ -149,7 +152,7 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
         {
             return None;
         }
-        while start > 0 && predicted(&circle, &samples[start - 1]) {
+        while start > 0 && predicted(&circle, &samples[start..=end], &samples[start - 1]) {
             match edge_circle(&samples[start - 1..=end]) {
                 Some(wider) => circle = wider,
                 None => break,
@@ -186,6 +189,10 @@ pub(super) fn roll_through(samples: &[RollSample], at: usize, noise_sigma_mm: f6
 /// Centres behind a point that show the path bending where a roll may start: the quartic's half window.
 const BENDING_BEHIND: usize = 4;
 
+/// The least turn of a run's reported normals that shows a roll starting, rad (1 deg): more than a machine's
+/// normals wander along a face.
+const MIN_NORMAL_TURN_RAD: f64 = 0.0175;
+
 /// Whether a roll may be starting at the point `at`: the centres from it to the newest lie on a sharp edge's
 /// circle, convex and turning less than [`MIN_TURN_RAD`] so far, and the centres after it leave the line of the
 /// few before it (so they are not a finely scanned face's, which any circle as wide as the ball fits over a short
@@ -196,14 +203,39 @@ fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
     if run.len() < 3 {
         return false;
     }
-    let Some(circle) = Circle::algebraic(run).and_then(|c| c.sharpened(run)) else {
-        return false;
-    };
     let behind = &samples[at.saturating_sub(BENDING_BEHIND)..=at];
-    circle.holds(run, tolerance)
-        && circle.roll_at(run, 0) == Some(None)
-        && behind.len() > 2
-        && leaves_the_line(behind, &samples[at + 1..], tolerance)
+    // Over a few degrees the centres' own circle may lie anywhere along them (its sag is under the noise, and its
+    // fit's middle slides along the arc): the one the reported normals point from is tried too, as it is.
+    [
+        Circle::algebraic(run).and_then(|c| c.sharpened(run)),
+        Circle::from_normals(run),
+    ]
+    .into_iter()
+    .flatten()
+    .any(|circle| {
+        circle.holds(run, tolerance)
+            && circle.roll_at(run, 0) == Some(None)
+            && (behind.len() > 2 && leaves_the_line(behind, &samples[at + 1..], tolerance)
+                || normals_turn_with(&circle, run))
+    })
+}
+
+/// Whether the reported normals of a run turn with its centres about the circle's middle: by at least half as much,
+/// the same way, and by at least [`MIN_NORMAL_TURN_RAD`]. A finely scanned face's centres fit a ball-wide circle
+/// over a short stretch too, but its normals stay put.
+///
+/// Why besides [`leaves_the_line`]: a roll in steps of half a degree (a blade's edge 0.95 mm inside the master's,
+/// grazed by probing lines through the master's apex) starts right after the roll's first centres, which the line
+/// of the few centres before it bends through; its centres did not leave that line within the look-ahead, and 14
+/// of its contacts took the quartic over centres 10 um apart, 28-83 um off the apex. Waiting costs only latency:
+/// a point that waits comes out as it would have at once once the centres tell.
+fn normals_turn_with(circle: &Circle, run: &[RollSample]) -> bool {
+    let (first, last) = (run[0].normal, run[run.len() - 1].normal);
+    let normals = first.perp(&last).atan2(first.dot(&last));
+    let centres = circle.turn(run);
+    normals.abs() >= MIN_NORMAL_TURN_RAD
+        && normals.signum() == centres.signum()
+        && normals.abs() >= 0.5 * centres.abs()
 }
 
 /// Whether a run's centres show a round edge, not a sharp one: the free radius of their circle, fitted without the
@@ -298,6 +330,19 @@ impl Circle {
         })
     }
 
+    /// The sharp edge's circle the reported normals point from: its middle the mean of the centres moved back
+    /// their `rho` along their normals. `None` where no normal has an in-plane direction.
+    fn from_normals(run: &[RollSample]) -> Option<Self> {
+        let backs: Vec<Vector2<f64>> = run
+            .iter()
+            .filter_map(|s| Some(s.centre - s.normal.try_normalize(0.0)? * s.rho))
+            .collect();
+        (!backs.is_empty()).then(|| Circle {
+            middle: backs.iter().sum::<Vector2<f64>>() / backs.len() as f64,
+            surface_radius: 0.0,
+        })
+    }
+
     /// The least-squares circle (orthogonal distances, each centre's own `rho` taken off), refined from the
     /// algebraic one by Gauss-Newton. `None` for centres on a line or repeated.
     fn fit(run: &[RollSample]) -> Option<Self> {
@@ -358,11 +403,47 @@ impl Circle {
         })
     }
 
-    /// The circle of the same kind as this one (sharp, or round with its radius fitted) fitted to `run`.
+    /// The circle of the same kind as this one (sharp, or round with its radius fitted) fitted to `run`; a sharp
+    /// one from this one's middle (a run bunched over a few degrees has an algebraic circle anywhere along it,
+    /// from which Gauss-Newton need not come back).
     fn refit(&self, run: &[RollSample]) -> Option<Self> {
         match self.surface_radius {
-            0.0 => Self::algebraic(run)?.sharpened(run),
+            0.0 => self.sharpened(run),
             _ => Self::fit(run),
+        }
+    }
+
+    /// The variance of this circle's residual at the centre `s`, fitted to `run`, in units of the centres' own
+    /// noise variance: `g^T (J^T J)^-1 g`, with `J` the residuals' gradients over the run's centres and `g` the
+    /// one at `s`, with respect to the circle's parameters (its middle, and its radius where fitted). 0 where the
+    /// run cannot tell (repeated centres).
+    ///
+    /// Why: a centre joins a roll where it lies on the circle of the run beside it, and that circle is only as
+    /// sure as the run's spread round it. A roll bunched in steps of half a degree (a blade's trailing edge 0.95 mm
+    /// inside the master's, the ball grazing it on lines through the master's apex) turns 20 deg over 18 centres
+    /// before jumping 75 deg: its circle predicts the next centre only within about 5 um (one sd) at 2 um noise,
+    /// and the fixed limits (6 um outside) left the roll's contacts to the quartic over centres 10 um apart.
+    fn extrapolation(&self, run: &[RollSample], s: &RollSample) -> f64 {
+        let unit = |c: &RollSample| (c.centre - self.middle).try_normalize(0.0);
+        let Some(at) = unit(s) else { return 0.0 };
+        if self.surface_radius == 0.0 {
+            let jtj = run
+                .iter()
+                .filter_map(unit)
+                .fold(Matrix2::<f64>::zeros(), |m, u| m + u * u.transpose());
+            jtj.try_inverse()
+                .map_or(0.0, |inverse| (at.transpose() * inverse * at)[(0, 0)])
+        } else {
+            let gradient = |u: Vector2<f64>| Vector3::new(u.x, u.y, 1.0);
+            let jtj = run
+                .iter()
+                .filter_map(unit)
+                .fold(Matrix3::<f64>::zeros(), |m, u| {
+                    m + gradient(u) * gradient(u).transpose()
+                });
+            let g = gradient(at);
+            jtj.try_inverse()
+                .map_or(0.0, |inverse| (g.transpose() * inverse * g)[(0, 0)])
         }
     }
 
