@@ -214,12 +214,13 @@ fn assert_best_fits_recover_the_blade_errors(
     );
 }
 
-/// Blades 1 to 2 % long of chord (B) and 0.5 to 1 % short (C), in their places (config/sims/
+/// Blades 1 to 2 % long of chord (B) and 1 to 1.1 % short (C), in their places (config/sims/
 /// propeller-chord-errors.toml): each edge lies up to 1 mm from where the blades' scans were planned on the master,
 /// so their trailing edges are rolled round in steps the plan did not choose. Every section's parameters still read
 /// the simulator's scales back (the chord within the 5 um: C r400 read 5.7 um short while such a roll's
-/// free radius could read its sharp edge as a round), and the run fails on the points alone, 1 mm off the master
-/// at the trailing edges.
+/// free radius could read its sharp edge as a round; C r100, its trailing edge 0.95 mm inside A's and grazed in
+/// steps of half a degree, read its camber 27 um and its chord angle 23 mdeg off while such a roll was left to the
+/// quartic), and the run fails on the points alone, 1 mm off the master at the trailing edges.
 #[test]
 fn inspect_reads_back_chords_longer_and_shorter_than_the_masters() {
     let station = Station::start("propeller-chord-errors.toml");
