@@ -204,20 +204,25 @@ fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
         return false;
     }
     let behind = &samples[at.saturating_sub(BENDING_BEHIND)..=at];
-    // Over a few degrees the centres' own circle may lie anywhere along them (its sag is under the noise, and its
-    // fit's middle slides along the arc): the one the reported normals point from is tried too, as it is.
-    [
-        Circle::algebraic(run).and_then(|c| c.sharpened(run)),
-        Circle::from_normals(run),
-    ]
-    .into_iter()
-    .flatten()
-    .any(|circle| {
-        circle.holds(run, tolerance)
-            && circle.roll_at(run, 0) == Some(None)
+    let starts_a_roll =
+        |circle: &Circle| circle.holds(run, tolerance) && circle.roll_at(run, 0) == Some(None);
+    if let Some(circle) = Circle::algebraic(run).and_then(|c| c.sharpened(run)) {
+        if starts_a_roll(&circle)
             && (behind.len() > 2 && leaves_the_line(behind, &samples[at + 1..], tolerance)
                 || normals_turn_with(&circle, run))
-    })
+        {
+            return true;
+        }
+    }
+    // Over a few degrees the centres' own circle may lie anywhere along them (its sag is under the noise, and its
+    // fit's middle slides along the arc): the one the reported normals point from is tried too, as it is.
+    // First, cheaply: the normals turn by at least half the angle the centres' span subtends on a ball's circle
+    // (a face bending wider than the ball turns its normals by less).
+    let (first, last) = (&run[0], &run[run.len() - 1]);
+    let normals = first.normal.angle(&last.normal);
+    normals >= 0.5 * (last.centre - first.centre).norm() / first.rho
+        && Circle::from_normals(run)
+            .is_some_and(|circle| normals_turn_with(&circle, run) && starts_a_roll(&circle))
 }
 
 /// Whether the reported normals of a run turn with its centres about the circle's middle: by at least half as much,
@@ -230,12 +235,14 @@ fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
 /// of its contacts took the quartic over centres 10 um apart, 28-83 um off the apex. Waiting costs only latency:
 /// a point that waits comes out as it would have at once once the centres tell.
 fn normals_turn_with(circle: &Circle, run: &[RollSample]) -> bool {
-    let (first, last) = (run[0].normal, run[run.len() - 1].normal);
-    let normals = first.perp(&last).atan2(first.dot(&last));
-    let centres = circle.turn(run);
-    normals.abs() >= MIN_NORMAL_TURN_RAD
-        && normals.signum() == centres.signum()
-        && normals.abs() >= 0.5 * centres.abs()
+    let turn = |from: Vector2<f64>, to: Vector2<f64>| from.perp(&to).atan2(from.dot(&to));
+    let (first, last) = (&run[0], &run[run.len() - 1]);
+    let normals = turn(first.normal, last.normal);
+    normals.abs() >= MIN_NORMAL_TURN_RAD && {
+        // The run turns less than MIN_TURN_RAD about the circle, so its ends tell its turn.
+        let centres = turn(first.centre - circle.middle, last.centre - circle.middle);
+        normals.signum() == centres.signum() && normals.abs() >= 0.5 * centres.abs()
+    }
 }
 
 /// Whether a run's centres show a round edge, not a sharp one: the free radius of their circle, fitted without the
