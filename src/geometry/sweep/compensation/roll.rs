@@ -195,9 +195,9 @@ const MIN_NORMAL_TURN_RAD: f64 = 0.0175;
 
 /// Whether a roll may be starting at the point `at`: the centres from it to the newest lie on a sharp edge's
 /// circle, convex and turning less than [`MIN_TURN_RAD`] so far, and the centres after it leave the line of the
-/// few before it (so they are not a finely scanned face's, which any circle as wide as the ball fits over a short
-/// stretch). In steps of a few degrees, the first centres of a roll are too close together for
-/// [`bends_like_an_edge`] to see their circle.
+/// few before it or the reported normals turn with them (either says they are not a finely scanned face's, which
+/// any circle as wide as the ball fits over a short stretch). In steps of a few degrees, the first centres of a
+/// roll are too close together for [`bends_like_an_edge`] to see their circle.
 fn roll_may_follow(samples: &[RollSample], at: usize, tolerance: f64) -> bool {
     let run = &samples[at..];
     if run.len() < 3 {
