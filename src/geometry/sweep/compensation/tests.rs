@@ -785,6 +785,20 @@ fn a_small_round_edge_is_found_with_its_radius_and_its_contacts_on_it() {
     }
 }
 
+/// An open scan's contacts with a 1 mm ball, compensated at once; streamed point by point, they come out the same.
+fn streamed_as_batched(path: &[(Point3<f64>, Vector3<f64>)]) -> Vec<Compensated> {
+    let settings = CompensationSettings::new(1.0);
+    let out = compensate_path(settings, Vector3::z(), path, false);
+    let mut compensator = Compensator::new(settings, Vector3::z());
+    let mut streamed: Vec<Compensated> = path
+        .iter()
+        .flat_map(|(c, n)| compensator.push(*c, *n))
+        .collect();
+    streamed.extend(compensator.finish());
+    assert_eq!(streamed, out);
+    out
+}
+
 #[test]
 fn a_roll_that_starts_in_small_steps_puts_its_first_contacts_on_the_edge() {
     // A scan planned on a nominal section rolls round the trailing edge of a part turned from it in uneven steps:
@@ -809,15 +823,7 @@ fn a_roll_that_starts_in_small_steps_puts_its_first_contacts_on_the_edge() {
         steps.push(turn - steps.iter().sum::<f64>());
         let truth = sharp_edge_rolled(half_angle, 0.1 + 0.4 * rng.gen::<f64>(), rng.gen(), &steps);
         let path = with_noise(scan(&truth, 1.0, 0.0), 0.002, &mut rng);
-        let settings = CompensationSettings::new(1.0);
-        let out = compensate_path(settings, Vector3::z(), &path, false);
-        let mut compensator = Compensator::new(settings, Vector3::z());
-        let mut streamed: Vec<Compensated> = path
-            .iter()
-            .flat_map(|(c, n)| compensator.push(*c, *n))
-            .collect();
-        streamed.extend(compensator.finish());
-        assert_eq!(streamed, out);
+        let out = streamed_as_batched(&path);
         assert!(out.iter().enumerate().all(|(i, c)| c.index == i));
         for c in &out[LOOK_AHEAD..out.len() - LOOK_AHEAD] {
             let (x, _) = truth[c.index];
@@ -952,15 +958,7 @@ fn a_roll_bunched_in_steps_of_half_a_degree_puts_every_contact_on_the_edge() {
         steps.push(turn - steps.iter().sum::<f64>());
         let truth = sharp_edge_rolled(half_angle, 0.5 + 0.5 * rng.gen::<f64>(), rng.gen(), &steps);
         let path = with_noise(scan(&truth, 1.0, 0.0), 0.002, &mut rng);
-        let settings = CompensationSettings::new(1.0);
-        let out = compensate_path(settings, Vector3::z(), &path, false);
-        let mut compensator = Compensator::new(settings, Vector3::z());
-        let mut streamed: Vec<Compensated> = path
-            .iter()
-            .flat_map(|(c, n)| compensator.push(*c, *n))
-            .collect();
-        streamed.extend(compensator.finish());
-        assert_eq!(streamed, out);
+        let out = streamed_as_batched(&path);
         for c in out.iter().filter(|c| truth[c.index].0 == Vector2::zeros()) {
             let off = c.surface.coords.norm();
             worst = worst.max(off);
