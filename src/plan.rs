@@ -28,7 +28,7 @@ const STOP_CENTRE_OFF_START_MM: f64 = 1.0;
 const HEADING_POINT_MM: f64 = 10.0;
 
 /// Nominals closer than this to a neighbour are one point of a sharp edge that the ball rolled around, mm.
-const EDGE_POINT_MM: f64 = 0.05;
+pub(crate) const EDGE_POINT_MM: f64 = 0.05;
 
 /// A curve scan starts at least this far from a sharp edge, mm, where the profile leaves room: the compensation
 /// of a roll round the edge looks back along the centres before it (up to 24 of them), which a scan that has

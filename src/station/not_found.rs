@@ -10,12 +10,11 @@
 
 use zeroset_drivers::machine::{CurveScan, Density};
 
+// Nominals this close together are one point of a sharp edge with a fan of normals, as the plan made them.
+use crate::plan::EDGE_POINT_MM;
+
 /// I++ DME 1.4.3, error table: 1006, "Surface not found" (severity 2).
 pub(super) const SURFACE_NOT_FOUND: u16 = 1006;
-
-/// Nominals of a curve scan this close together, mm, are one point of a sharp edge with a fan of normals: where
-/// the ball rolls round the master's edge (the plan's nominals there are the edge's apex; see `plan`).
-const ONE_POINT_MM: f64 = 0.05;
 
 /// The text appended to the machine's "Surface not found" for a curve scan of `scan` that had measured
 /// `measured` points when it stopped, with a ball of `ball_radius_mm`.
@@ -71,7 +70,7 @@ fn off_a_sharp_edge(scan: &CurveScan, i: usize) -> Option<f64> {
         neighbours
             .into_iter()
             .flatten()
-            .any(|j| j != k && (at(j) - at(k)).norm() < ONE_POINT_MM)
+            .any(|j| j != k && (at(j) - at(k)).norm() < EDGE_POINT_MM)
     };
     (0..n)
         .filter(|&k| shares_a_point(k))
