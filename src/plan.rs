@@ -28,7 +28,7 @@ const STOP_CENTRE_OFF_START_MM: f64 = 1.0;
 const HEADING_POINT_MM: f64 = 10.0;
 
 /// Nominals closer than this to a neighbour are one point of a sharp edge that the ball rolled around, mm.
-pub(crate) const EDGE_POINT_MM: f64 = 0.05;
+const EDGE_POINT_MM: f64 = 0.05;
 
 /// A curve scan starts at least this far from a sharp edge, mm, where the profile leaves room: the compensation
 /// of a roll round the edge looks back along the centres before it (up to 24 of them), which a scan that has
@@ -217,12 +217,15 @@ impl Plan {
     /// points most nearly up (+z in machine coordinates), so the approach from the clearance height above
     /// it is a straight vertical move. `sharp_edges` are the profile's, found in the master's scan: their
     /// rolls keep the scan's `max_angle_deg`, the rest of the profile may be scanned finer round its round
-    /// edges (see [`ScanSettings::round_edge_max_angle_deg`]).
+    /// edges (see [`ScanSettings::round_edge_max_angle_deg`]), and near them the probing lines fan out from a
+    /// pivot inside the master's edge (see `fan`), aimed at the centres of a ball of `ball_radius_mm`, the ball
+    /// the motion is planned and swept for.
     pub fn curve_scan(
         &self,
         key: ProfileKey,
         nominals: &[NominalPoint],
         sharp_edges: &[SharpEdge],
+        ball_radius_mm: f64,
     ) -> CurveScan {
         let placement = self.instance_to_machine(key.instance);
         let first = if nominals.is_empty() {
@@ -235,10 +238,10 @@ impl Plan {
         let rolling: Vec<bool> = in_order()
             .map(|n| rolling(&Point3::from(n.point), &apexes))
             .collect();
-        let nominals: Vec<Nominal> = in_order()
+        let taught: Vec<Nominal> = in_order()
             .map(|n| Nominal {
-                point: xyz(&(placement * Point3::from(n.point)).coords),
-                normal: xyz(&(placement * Vector3::from(n.normal)).normalize()),
+                point: xyz(&Vector3::from(n.point)),
+                normal: xyz(&Vector3::from(n.normal).normalize()),
             })
             .collect();
         let scan = &self.part.scan;
@@ -251,13 +254,42 @@ impl Plan {
                 round_edge_angle
             }
         };
+        let depth = fan::pivot_depth_mm(scan.max_deviation_mm, ball_radius_mm);
+        let dense = at_density(&taught, scan.step_mm, max_angle);
+        let nominals = fan::fanned(&dense, sharp_edges, depth, ball_radius_mm)
+            .iter()
+            .map(|n| Nominal {
+                point: xyz(&(placement * Point3::new(n.point.x, n.point.y, n.point.z)).coords),
+                normal: xyz(&(placement * Vector3::new(n.normal.x, n.normal.y, n.normal.z))),
+            })
+            .collect();
         CurveScan {
             closed: true,
-            nominals: at_density(&nominals, scan.step_mm, max_angle),
+            nominals,
             max_deviation: scan.max_deviation_mm,
             min_radius: scan.min_radius_mm,
             density: Density::AtNominals,
         }
+    }
+
+    /// The sharp edges of a curve scan's profile (see [`Plan::curve_scan`]) on `key`'s instance, with the depth of
+    /// their fans' pivots.
+    pub fn edge_fans(
+        &self,
+        key: ProfileKey,
+        sharp_edges: &[SharpEdge],
+        ball_radius_mm: f64,
+    ) -> Vec<EdgeFan> {
+        let placement = self.instance_to_machine(key.instance);
+        let x = self.profile_x(key.profile);
+        let depth_mm = fan::pivot_depth_mm(self.part.scan.max_deviation_mm, ball_radius_mm);
+        sharp_edges
+            .iter()
+            .map(|edge| EdgeFan {
+                apex: placement * Point3::new(x, edge.apex[0], edge.apex[1]),
+                depth_mm,
+            })
+            .collect()
     }
 
     /// The index into `remaining` of the scan to do next from `from`: the one whose start is nearest.
@@ -476,5 +508,7 @@ fn xyz(v: &Vector3<f64>) -> Xyz {
     Xyz::new(v.x, v.y, v.z)
 }
 
+mod fan;
+pub use fan::EdgeFan;
 #[cfg(test)]
 mod tests;

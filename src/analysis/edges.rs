@@ -55,6 +55,13 @@ impl SharpEdge {
         Vector2::new(n.x * cos - n.y * sin, n.x * sin + n.y * cos)
     }
 
+    /// The outward direction halfway between the two faces' normals: straight out of the edge's tip.
+    pub(crate) fn bisector(&self) -> Vector2<f64> {
+        let (sin, cos) = (self.turn_rad / 2.0).sin_cos();
+        let n = self.from();
+        Vector2::new(n.x * cos - n.y * sin, n.x * sin + n.y * cos)
+    }
+
     /// Whether a direction from the apex lies in the normal cone: between the two faces' normals, the way the
     /// normal turns.
     fn in_cone(&self, offset: &Vector2<f64>) -> bool {

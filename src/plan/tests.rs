@@ -220,7 +220,7 @@ fn circle() -> Vec<NominalPoint> {
 fn a_curve_scan_starts_at_the_most_upward_normal_and_keeps_the_taught_order() {
     let plan = plan();
     let nominals = circle();
-    let scan = plan.curve_scan(key(0, 1), &nominals, &[]);
+    let scan = plan.curve_scan(key(0, 1), &nominals, &[], 1.5);
     assert!(scan.closed);
     // Each taught step (30 deg, 5.18 mm) is cut into PER_STEP at the scan's 1 mm: taught nominal k is the
     // scan's PER_STEP k-th.
@@ -317,7 +317,7 @@ fn round_edges_are_scanned_finer_and_a_sharp_edges_roll_keeps_the_scans_angle() 
             .map(|i| turn(&scan.nominals[i].normal, &scan.nominals[(i + 1) % n].normal))
             .fold(0.0, f64::max)
     };
-    let round = plan.curve_scan(key(0, 1), &circle(), &[]);
+    let round = plan.curve_scan(key(0, 1), &circle(), &[], 1.5);
     assert_eq!(round.nominals.len(), 12 * 8);
     assert!(largest_turn(&round) <= 4.0, "{}", largest_turn(&round));
     let edge = SharpEdge {
@@ -325,20 +325,33 @@ fn round_edges_are_scanned_finer_and_a_sharp_edges_roll_keeps_the_scans_angle() 
         from_normal: [0.0, 1.0],
         turn_rad: -std::f64::consts::FRAC_PI_2,
     };
-    let sharp = plan.curve_scan(key(0, 1), &circle(), &[edge]);
+    let sharp = plan.curve_scan(key(0, 1), &circle(), &[edge], 1.5);
     assert_eq!(sharp.nominals.len(), 10 * 8 + 2 * 6);
-    // Six pieces of 30 deg by normals interpolated along their chord: about 5 deg, 5.1 at the middle.
-    let beside_edge = largest_turn(&sharp);
+    // Six pieces of 30 deg by normals interpolated along their chord: about 5 deg, 5.1 at the middle. The
+    // nominals within the fan's 1 mm of the apex (the apex and one 0.86 mm off it each side) probe along lines
+    // through its pivot instead, and are left out.
+    let apex = Point3::new(200.0, 10.0, 20.0);
+    let off_the_fan = |n: &Nominal| (point(&n.point) - apex).norm() >= 1.0;
+    let n = sharp.nominals.len();
+    let pairs_off_the_fan: Vec<(Nominal, Nominal)> = (0..n)
+        .map(|i| (sharp.nominals[i], sharp.nominals[(i + 1) % n]))
+        .filter(|(a, b)| off_the_fan(a) && off_the_fan(b))
+        .collect();
+    assert_eq!(pairs_off_the_fan.len(), n - 4);
+    let beside_edge = pairs_off_the_fan
+        .iter()
+        .map(|(a, b)| turn(&a.normal, &b.normal))
+        .fold(0.0, f64::max);
     assert!(beside_edge > 5.0 && beside_edge < 5.2, "{beside_edge}");
     // Without the key every step is cut at the scan's own 1 mm and 10 deg.
-    let coarse = self::plan().curve_scan(key(0, 1), &circle(), &[edge]);
+    let coarse = self::plan().curve_scan(key(0, 1), &circle(), &[edge], 1.5);
     assert_eq!(coarse.nominals.len(), 12 * PER_STEP);
 }
 
 #[test]
 fn a_curve_scan_on_blade_b_turns_points_and_normals() {
     let plan = plan();
-    let scan = plan.curve_scan(key(1, 1), &circle(), &[]);
+    let scan = plan.curve_scan(key(1, 1), &circle(), &[], 1.5);
     let (cos, sin) = TURN_120;
     // The top (200, 0, 30) turned onto blade B; its normal, up, stays up.
     assert_near(
@@ -367,7 +380,7 @@ fn a_fixture_turn_that_tilts_nothing_keeps_the_upward_start() {
         ..Pose::default()
     };
     let plan = Plan::new(&part_at_max_angle(), turned.isometry());
-    let scan = plan.curve_scan(key(2, 0), &circle(), &[]);
+    let scan = plan.curve_scan(key(2, 0), &circle(), &[], 1.5);
     assert_near(&scan.nominals[0].normal, [0.0, 0.0, 1.0], "first normal");
     let z: Vec<f64> = scan.nominals.iter().map(|n| n.point.z).collect();
     assert_eq!(z.len(), 12 * PER_STEP);

@@ -12,7 +12,7 @@ use super::escape::{way_out, KnownPath};
 use crate::analysis::Reference;
 use crate::api::JobKind;
 use crate::config::{MachineEntry, Safety};
-use crate::plan::{Plan, ProfileKey};
+use crate::plan::{EdgeFan, Plan, ProfileKey};
 use zeroset_drivers::machine::{CurveScan, InPlaneScan};
 
 /// Teaching starts from a point of the drawing, not of the part: the probe enters this far above it, mm.
@@ -54,6 +54,9 @@ pub struct ScanMotion {
     pub retract: Vec<Point3<f64>>,
     /// The ball radius these positions are planned for, mm.
     pub ball_radius_mm: f64,
+    /// A curve scan's sharp edges, whose probing lines fan out from a pivot inside them: what a stop there is
+    /// explained by. None for other scans.
+    pub edges: Vec<EdgeFan>,
 }
 
 /// Why a scan's motion cannot be planned.
@@ -81,12 +84,18 @@ pub fn scan_motion(
     safety: &Safety,
 ) -> Result<ScanMotion, PlanError> {
     let name = format!("part {}, {}", plan.part(), plan.describe(key));
-    let (scan, path, kind) = match reference {
+    let (scan, path, kind, edges) = match reference {
         Some(reference) => {
             let profile = &reference.profiles[key.profile];
-            let scan = plan.curve_scan(key, &profile.nominals, &profile.edges);
+            let scan = plan.curve_scan(
+                key,
+                &profile.nominals,
+                &profile.edges,
+                safety.max_ball_radius_mm,
+            );
             let path = KnownPath::of_curve_scan(&scan);
-            (Scan::Curve(scan), path, JobKind::Inspect)
+            let edges = plan.edge_fans(key, &profile.edges, safety.max_ball_radius_mm);
+            (Scan::Curve(scan), path, JobKind::Inspect, edges)
         }
         None => {
             let scan = plan.in_plane_scan(key);
@@ -102,10 +111,11 @@ pub fn scan_motion(
                 closed: false,
                 entry: 0,
             };
-            (Scan::InPlane(scan), path, JobKind::Teach)
+            (Scan::InPlane(scan), path, JobKind::Teach, Vec::new())
         }
     };
-    ScanMotion::plan(key, name, scan, path, scan_margin_mm(plan, kind), safety)
+    let motion = ScanMotion::plan(key, name, scan, path, scan_margin_mm(plan, kind), safety)?;
+    Ok(ScanMotion { edges, ..motion })
 }
 
 impl ScanMotion {
@@ -149,6 +159,7 @@ impl ScanMotion {
             end_tolerance_mm: margin + END_TOLERANCE_MM,
             retract,
             ball_radius_mm: radius,
+            edges: Vec::new(),
         })
     }
 }

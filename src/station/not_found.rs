@@ -3,22 +3,27 @@
 //!
 //! Why it matters: the machine's error names neither the point nor the cause, and the usual next step (`zeroset
 //! clear`, which scans the profile again) fails the same way when the cause is the part itself. Round a sharp edge
-//! the master's nominals are one point, the apex, with a fan of normals: each probing line passes through the
-//! master's apex, so it finds the part's edge only within about the ball's radius of it, as do the face normals
-//! just before it. A blade whose trailing edge lies farther inside (a chord 1-2 % short moves each end 0.5-1.8 mm)
-//! or off across the edge stops there.
+//! the probing lines pass through a pivot inside the master's edge (`plan::fan`), so they find the part's edge only
+//! up to about the pivot's depth plus the ball's radius inside the master's, and about the ball's radius off across
+//! it. A blade whose trailing edge lies farther off (inside it along the chord, a chord short by twice that or more,
+//! or off across the edge) stops there.
 
+use nalgebra::Point3;
 use zeroset_drivers::machine::{CurveScan, Density};
 
-// Nominals this close together are one point of a sharp edge with a fan of normals, as the plan made them.
-use crate::plan::EDGE_POINT_MM;
+use crate::plan::EdgeFan;
 
 /// I++ DME 1.4.3, error table: 1006, "Surface not found" (severity 2).
 pub(super) const SURFACE_NOT_FOUND: u16 = 1006;
 
-/// The text appended to the machine's "Surface not found" for a curve scan of `scan` that had measured
-/// `measured` points when it stopped, with a ball of `ball_radius_mm`.
-pub(super) fn where_not_found(scan: &CurveScan, measured: usize, ball_radius_mm: f64) -> String {
+/// The text appended to the machine's "Surface not found" for a curve scan of `scan` (whose sharp edges are
+/// `edges`) that had measured `measured` points when it stopped, with a ball of `ball_radius_mm`.
+pub(super) fn where_not_found(
+    scan: &CurveScan,
+    edges: &[EdgeFan],
+    measured: usize,
+    ball_radius_mm: f64,
+) -> String {
     let total = scan.nominals.len();
     // With one point per nominal, the scan stopped probing the nominal after the last one it measured.
     if scan.density != Density::AtNominals || measured >= total {
@@ -36,14 +41,15 @@ pub(super) fn where_not_found(scan: &CurveScan, measured: usize, ball_radius_mm:
          of the master's nominal at ({:.3}, {:.3}, {:.3}) mm",
         n.x, n.y, n.z, p.x, p.y, p.z
     );
-    match off_a_sharp_edge(scan, measured) {
-        Some(off) => format!(
-            "{along}, {off:.2} mm from the master's sharp edge (the apex its ball rolls round): the probing lines \
-             beside and round it find the part's edge only within about the ball's radius ({ball_radius_mm} mm) of \
-             the master's, and this part's edge lies farther off (inside it along the chord, a blade short of chord \
-             by about twice that or more, or off across it). Scanning this profile again along the master's curve \
-             stops the same way: check the part against the master; `zeroset abort` ends the job with the scans so \
-             far kept"
+    match near_a_sharp_edge(scan, edges, &Point3::new(p.x, p.y, p.z)) {
+        Some((off, edge)) => format!(
+            "{along}, {off:.2} mm from the master's sharp edge at ({:.3}, {:.3}, {:.3}) mm: the probing lines beside \
+             and round it pass through a point {:.2} mm inside the master's edge, and find the part's edge only up to \
+             about that plus the ball's radius ({ball_radius_mm} mm) inside the master's, or about the ball's radius \
+             off across it. This part's edge lies farther off (a blade short of chord by about twice that or more, \
+             or off across the edge). Scanning this profile again along the master's curve stops the same way: check \
+             the part against the master; `zeroset abort` ends the job with the scans so far kept",
+            edge.apex.x, edge.apex.y, edge.apex.z, edge.depth_mm
         ),
         None => format!(
             "{along}: the part lies farther from the master's surface there than {} mm ([scan] max_deviation_mm) \
@@ -54,29 +60,18 @@ pub(super) fn where_not_found(scan: &CurveScan, measured: usize, ball_radius_mm:
     }
 }
 
-/// How far nominal `i` lies from the nearest sharp edge's apex (a point the nominals before or after it share, with
-/// a fan of normals), mm, where that is within the scan's `max_deviation`: as far as a part's edge may lie off.
-fn off_a_sharp_edge(scan: &CurveScan, i: usize) -> Option<f64> {
-    let n = scan.nominals.len();
-    let at = |k: usize| {
-        let p = scan.nominals[k].point;
-        nalgebra::Point3::new(p.x, p.y, p.z)
-    };
-    let shares_a_point = |k: usize| {
-        let neighbours = [
-            (k > 0 || scan.closed).then(|| (k + n - 1) % n),
-            (k + 1 < n || scan.closed).then(|| (k + 1) % n),
-        ];
-        neighbours
-            .into_iter()
-            .flatten()
-            .any(|j| j != k && (at(j) - at(k)).norm() < EDGE_POINT_MM)
-    };
-    (0..n)
-        .filter(|&k| shares_a_point(k))
-        .map(|k| (at(k) - at(i)).norm())
-        .filter(|&off| off <= scan.max_deviation)
-        .min_by(f64::total_cmp)
+/// The nearest of `edges` to a nominal `at`, and how far its apex is, mm, where that is within the scan's
+/// `max_deviation`: as far as a part's edge may lie off.
+fn near_a_sharp_edge<'a>(
+    scan: &CurveScan,
+    edges: &'a [EdgeFan],
+    at: &Point3<f64>,
+) -> Option<(f64, &'a EdgeFan)> {
+    edges
+        .iter()
+        .map(|edge| ((edge.apex - at).norm(), edge))
+        .filter(|(off, _)| *off <= scan.max_deviation)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 #[cfg(test)]
@@ -110,30 +105,49 @@ mod tests {
         }
     }
 
+    /// The apex of [`blade_end`], its fan pivoting 1 mm inside it.
+    fn apex() -> [EdgeFan; 1] {
+        [EdgeFan {
+            apex: Point3::new(0.0, 10.0, 0.0),
+            depth_mm: 1.0,
+        }]
+    }
+
     #[test]
     fn a_stop_beside_or_round_a_sharp_edge_says_the_parts_edge_lies_off_the_masters() {
         let scan = blade_end();
         // Five face points measured: the sixth nominal, the apex's first normal, found nothing.
-        let text = where_not_found(&scan, 5, 1.0);
+        let text = where_not_found(&scan, &apex(), 5, 1.0);
         assert!(
             text.contains("after 5 of 13 points")
                 && text.contains("(0.000, 0.707, 0.707)")
-                && text
-                    .contains("at (0.000, 10.000, 0.000) mm, 0.00 mm from the master's sharp edge")
+                && text.contains(
+                    "at (0.000, 10.000, 0.000) mm, 0.00 mm from the master's sharp edge at (0.000, 10.000, \
+                     0.000) mm"
+                )
+                && text.contains("a point 1.00 mm inside the master's edge")
                 && text.contains("ball's radius (1 mm)")
                 && text.contains("stops the same way"),
             "{text}"
         );
         // The face points 2.24 mm before the apex, on either face: within the scan's 3 mm of it.
-        assert!(where_not_found(&scan, 4, 1.0).contains(", 2.24 mm from the master's sharp edge"));
-        assert!(where_not_found(&scan, 8, 1.0).contains(", 2.24 mm from the master's sharp edge"));
+        for face_point in [4, 8] {
+            let text = where_not_found(&scan, &apex(), face_point, 1.0);
+            assert!(
+                text.contains(", 2.24 mm from the master's sharp edge"),
+                "{text}"
+            );
+        }
+        // Without the edges the same stop is a stop on a face.
+        let text = where_not_found(&scan, &[], 5, 1.0);
+        assert!(!text.contains("sharp edge"), "{text}");
     }
 
     #[test]
     fn a_stop_on_a_face_says_how_far_the_scan_searched() {
         let scan = blade_end();
         // The face point 4.12 mm from the apex.
-        let text = where_not_found(&scan, 3, 1.0);
+        let text = where_not_found(&scan, &apex(), 3, 1.0);
         assert!(
             text.contains("after 3 of 13 points")
                 && text.contains("at (0.000, 6.000, 1.000) mm:")
@@ -142,7 +156,7 @@ mod tests {
             "{text}"
         );
         // A scan that measured every nominal and still reported the error: no nominal to name.
-        let text = where_not_found(&scan, 13, 1.0);
+        let text = where_not_found(&scan, &apex(), 13, 1.0);
         assert!(text.contains("after 13 points of the curve's 13"), "{text}");
     }
 }

@@ -784,9 +784,12 @@ impl Worker {
                         },
                     ) = (&motion.scan, error.kind)
                     {
-                        error
-                            .message
-                            .push_str(&where_not_found(plan, centres.len(), radius));
+                        error.message.push_str(&where_not_found(
+                            plan,
+                            &motion.edges,
+                            centres.len(),
+                            radius,
+                        ));
                     }
                     return Err(error);
                 }
