@@ -9,19 +9,21 @@
 //!
 //! So the lines round the edge, and those of the faces within the pivot's depth of it, pass through a pivot
 //! `depth` inside the master's apex along the edge's bisector, each aimed at the ball centre the planned ball has
-//! on the master there. On the master the ball stops where it did (the planned centres, which the clearance check
-//! sweeps, are unchanged); a part's edge up to `depth` plus the ball's radius inside the master's lies within every
-//! line's reach, and one at about `depth` inside is rolled round evenly.
+//! on the master there. The planned centres, which the clearance check sweeps, are unchanged, and a ball of the
+//! planned radius stops on the master where it did. A part's edge up to `depth` plus the ball's radius inside the
+//! master's lies within every line's reach, and one at about `depth` inside is rolled round evenly.
 
 use nalgebra::{Point3, Vector2, Vector3};
 use zeroset_drivers::machine::{Nominal, Xyz};
 
 use crate::analysis::edges::SharpEdge;
 
-/// The pivot's depth inside the master's apex, as a fraction of the planned ball's radius at most. At 2/3 the line
-/// aimed at a face's normal (85 deg off the bisector of a thin edge) passes 0.53 radii from the master's apex, so any
-/// ball down to about half the planned one still rolls round the apex on every line of the fan; deeper, the side
-/// lines of a smaller ball would touch the faces behind the apex, out of the scan's order.
+/// The pivot's depth inside the master's apex, as a fraction of the planned ball's radius at most. A ball smaller
+/// than the planned one meets the fan's outer lines (those aimed near a face's normal) on that face just behind the
+/// apex instead of on it, its contacts still moving along the face towards the apex: at 2/3, a 1 mm ball on a fan
+/// planned for 1.5 mm touches the faces up to 0.3 mm behind the apex on the lines more than about 69 deg off the
+/// bisector (the line 85 deg off passes 0.8 mm from the apex). Deeper, those contacts reach farther behind: at 4/3 a
+/// blade 1 mm long, so the pivot 3 mm inside its edge, read its chord 5.3 um long (BENCHMARKS.md, stop 50).
 const MAX_DEPTH_PER_RADIUS: f64 = 2.0 / 3.0;
 
 /// A sharp edge of a curve scan's profile as the scan's fan probes it, in machine coordinates.
@@ -54,9 +56,11 @@ pub(super) fn fanned(
         .map(|nominal| {
             let point = Point3::new(nominal.point.x, nominal.point.y, nominal.point.z);
             let in_plane = Vector2::new(point.y, point.z);
+            let off = |edge: &&SharpEdge| (in_plane - Vector2::from(edge.apex)).norm();
             let edge = edges
                 .iter()
-                .find(|edge| (in_plane - Vector2::from(edge.apex)).norm() < depth_mm);
+                .filter(|edge| off(edge) < depth_mm)
+                .min_by(|a, b| off(a).total_cmp(&off(b)));
             match edge {
                 Some(edge) => {
                     let normal = Vector3::new(nominal.normal.x, nominal.normal.y, nominal.normal.z);
@@ -120,6 +124,22 @@ mod tests {
 
     fn normal(n: &Nominal) -> Vector3<f64> {
         Vector3::new(n.normal.x, n.normal.y, n.normal.z)
+    }
+
+    #[test]
+    fn the_bisector_points_out_of_the_tip_whichever_face_the_scan_comes_from() {
+        let (from_upper, _) = thin_edge();
+        let from_lower = SharpEdge {
+            from_normal: [from_upper.from_normal[0], -from_upper.from_normal[1]],
+            turn_rad: -from_upper.turn_rad,
+            ..from_upper
+        };
+        for edge in [from_upper, from_lower] {
+            assert!(
+                (edge.bisector() - Vector2::new(1.0, 0.0)).norm() < 1e-12,
+                "{edge:?}"
+            );
+        }
     }
 
     #[test]

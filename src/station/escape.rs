@@ -19,7 +19,9 @@ use crate::geometry::sweep::part::PartDistance;
 /// A known stretch of surface along which the ball travelled, and where its scan entered.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KnownPath {
-    /// Surface points in the order of travel, machine coordinates, mm.
+    /// Surface points in the order of travel, machine coordinates, mm. A curve scan's are its nominal points:
+    /// near a sharp edge, where the plan fans the probing lines (`plan::fan`), points of the planned ball clear of
+    /// the master, up to about 0.8 mm off its surface, so a check against them is the stricter.
     pub surface: Vec<Point3<f64>>,
     /// Their outward unit normals.
     pub normals: Vec<Vector3<f64>>,

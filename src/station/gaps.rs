@@ -115,8 +115,9 @@ impl Segments {
 
 /// A curve scan is followed twice, along its nominal surface path and along its nominal ball-centre path (each
 /// nominal moved out along its normal by the ball's radius), and a gap along either is a gap. The surface path
-/// alone misses a hole round a sharp edge: there the nominals are one point with a fan of normals, so the
-/// surface path has no length where the ball rolls a half turn round it, several points of the scan (the
+/// alone misses a hole round a sharp edge: there the master's nominals are one point with a fan of normals (and
+/// the plan's fanned lines, `plan::fan`, spread them only across the planned ball's contact, about 1.6 mm), so the
+/// surface path has little or no length where the ball rolls a half turn round it, several points of the scan (the
 /// 1000-fault campaign lost 20 there, C r200 with 370 of 390 points, and the surface path saw 2.5 mm missing, less
 /// than its spacing allowed). The centre path alone, in its first campaign, passed a scan whose last 2 points were
 /// lost on a face (C r500, 270 of 272) that the surface path sees.

@@ -37,19 +37,33 @@ pub(super) fn where_not_found(
     let nominal = scan.nominals[measured];
     let (p, n) = (nominal.point, nominal.normal);
     let along = format!(
-        "; no surface was found after {measured} of {total} points, probing along the normal ({:.3}, {:.3}, {:.3}) \
-         of the master's nominal at ({:.3}, {:.3}, {:.3}) mm",
+        "; no surface was found after {measured} of {total} points, probing along the line of outward direction \
+         ({:.3}, {:.3}, {:.3}) through the nominal point ({:.3}, {:.3}, {:.3}) mm",
         n.x, n.y, n.z, p.x, p.y, p.z
     );
+    let again = "Scanning this profile again along the master's curve stops the same way: check the part against \
+                 the master; `zeroset abort` ends the job with the scans so far kept";
     match near_a_sharp_edge(scan, edges, &Point3::new(p.x, p.y, p.z)) {
-        Some((off, edge)) => format!(
-            "{along}, {off:.2} mm from the master's sharp edge at ({:.3}, {:.3}, {:.3}) mm: the probing lines beside \
-             and round it pass through a point {:.2} mm inside the master's edge, and find the part's edge only up to \
-             about that plus the ball's radius ({ball_radius_mm} mm) inside the master's, or about the ball's radius \
-             off across it. This part's edge lies farther off (a blade short of chord by about twice that or more, \
-             or off across the edge). Scanning this profile again along the master's curve stops the same way: check \
-             the part against the master; `zeroset abort` ends the job with the scans so far kept",
+        // Within the fan's depth of the apex the line is one of the fan's (`plan::fan`).
+        Some((off, edge)) if off < edge.depth_mm => format!(
+            "{along}, {off:.2} mm from the master's sharp edge at ({:.3}, {:.3}, {:.3}) mm: the probing lines round \
+             it pass through a point {:.2} mm inside the master's edge, and find the part's edge only up to about \
+             that plus the ball's radius ({ball_radius_mm} mm) inside the master's, or about the ball's radius off \
+             across it. This part's edge lies farther off (a blade short of chord by about twice that or more, or \
+             off across the edge). {again}",
             edge.apex.x, edge.apex.y, edge.apex.z, edge.depth_mm
+        ),
+        Some((off, edge)) => format!(
+            "{along}, {off:.2} mm from the master's sharp edge at ({:.3}, {:.3}, {:.3}) mm, on a face before the \
+             lines that fan round it: a face's line finds the part only where its face passes within about the \
+             ball's radius ({ball_radius_mm} mm) of it, so this part's edge lies about {:.2} mm or more inside the \
+             master's along the face (a blade short of chord), or its face lies off across it by more than {} mm \
+             ([scan] max_deviation_mm) plus the probe's search. {again}",
+            edge.apex.x,
+            edge.apex.y,
+            edge.apex.z,
+            (off - ball_radius_mm).max(0.0),
+            scan.max_deviation
         ),
         None => format!(
             "{along}: the part lies farther from the master's surface there than {} mm ([scan] max_deviation_mm) \
@@ -114,33 +128,39 @@ mod tests {
     }
 
     #[test]
-    fn a_stop_beside_or_round_a_sharp_edge_says_the_parts_edge_lies_off_the_masters() {
+    fn a_stop_round_a_sharp_edge_says_the_parts_edge_lies_beyond_the_fans_reach() {
         let scan = blade_end();
         // Five face points measured: the sixth nominal, the apex's first normal, found nothing.
         let text = where_not_found(&scan, &apex(), 5, 1.0);
         assert!(
             text.contains("after 5 of 13 points")
-                && text.contains("(0.000, 0.707, 0.707)")
+                && text.contains("direction (0.000, 0.707, 0.707)")
                 && text.contains(
-                    "at (0.000, 10.000, 0.000) mm, 0.00 mm from the master's sharp edge at (0.000, 10.000, \
-                     0.000) mm"
+                    "through the nominal point (0.000, 10.000, 0.000) mm, 0.00 mm from the master's sharp edge at \
+                     (0.000, 10.000, 0.000) mm: the probing lines round it pass through a point 1.00 mm inside"
                 )
-                && text.contains("a point 1.00 mm inside the master's edge")
-                && text.contains("ball's radius (1 mm)")
+                && text.contains("ball's radius (1 mm) inside the master's")
                 && text.contains("stops the same way"),
             "{text}"
         );
-        // The face points 2.24 mm before the apex, on either face: within the scan's 3 mm of it.
-        for face_point in [4, 8] {
-            let text = where_not_found(&scan, &apex(), face_point, 1.0);
-            assert!(
-                text.contains(", 2.24 mm from the master's sharp edge"),
-                "{text}"
-            );
-        }
         // Without the edges the same stop is a stop on a face.
         let text = where_not_found(&scan, &[], 5, 1.0);
         assert!(!text.contains("sharp edge"), "{text}");
+    }
+
+    #[test]
+    fn a_stop_on_a_face_beside_a_sharp_edge_says_how_far_inside_the_parts_edge_lies() {
+        let scan = blade_end();
+        // The face points 2.24 mm before the apex, on either face: within the scan's 3 mm of it, beyond the fan's 1.
+        for face_point in [4, 8] {
+            let text = where_not_found(&scan, &apex(), face_point, 1.0);
+            assert!(
+                text.contains(", 2.24 mm from the master's sharp edge at (0.000, 10.000, 0.000) mm, on a face")
+                    && text.contains("lies about 1.24 mm or more inside the master's")
+                    && !text.contains("pass through a point"),
+                "{text}"
+            );
+        }
     }
 
     #[test]
@@ -150,7 +170,7 @@ mod tests {
         let text = where_not_found(&scan, &apex(), 3, 1.0);
         assert!(
             text.contains("after 3 of 13 points")
-                && text.contains("at (0.000, 6.000, 1.000) mm:")
+                && text.contains("through the nominal point (0.000, 6.000, 1.000) mm:")
                 && text.contains("farther from the master's surface there than 3 mm")
                 && !text.contains("sharp edge"),
             "{text}"

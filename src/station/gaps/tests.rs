@@ -350,8 +350,9 @@ fn whole_scan_entered_at(
 }
 
 /// `path` with its sharp trailing edge (its point farthest along +y) made a fan of `count` nominals at that one
-/// point, their normals turning from the upper face's to the lower face's, as the station's nominals are: the
-/// ball rolls round the edge while the surface path stays where it is.
+/// point, their normals turning from the upper face's to the lower face's, as the master's taught nominals are
+/// (the plan then fans their lines out from a pivot inside the edge, `plan::fan`): the ball rolls round the edge
+/// while the surface path stays where it is.
 fn with_fan(path: &KnownPath, count: usize) -> KnownPath {
     let n = path.surface.len();
     let edge = edge(path, Edge::Trailing);
