@@ -508,7 +508,7 @@ fn xyz(v: &Vector3<f64>) -> Xyz {
     Xyz::new(v.x, v.y, v.z)
 }
 
-mod fan;
+pub(crate) mod fan;
 pub use fan::EdgeFan;
 #[cfg(test)]
 mod tests;

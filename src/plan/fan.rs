@@ -45,7 +45,7 @@ pub(super) fn pivot_depth_mm(max_deviation_mm: f64, ball_radius_mm: f64) -> f64 
 /// of a sharp edge's apex (in that plane, (y, z)) probed along the line from the edge's pivot to the centre of a
 /// ball of `ball_radius_mm` touching the master at that nominal: its point moved to where that ball touches the
 /// line's way in (one radius before the centre), its normal turned along the line. The rest are as they were.
-pub(super) fn fanned(
+pub(crate) fn fanned(
     nominals: &[Nominal],
     edges: &[SharpEdge],
     depth_mm: f64,

@@ -2,7 +2,7 @@
 //! its sharp trailing edge (the real blade 0.4 mm off the nominal, as blade B), and in a teach scan.
 
 use nalgebra::{Point3, Vector3};
-use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, InPlaneSpacing, Xyz};
+use zeroset_drivers::machine::{CurveScan, Density, InPlaneScan, InPlaneSpacing, Nominal, Xyz};
 use zeroset_sim::naca::Naca4;
 
 use super::*;
@@ -288,6 +288,71 @@ fn a_single_point_lost_anywhere_from_a_scan_at_its_nominals_is_a_gap_there() {
         assert!(find_gap(&motion, &[], BALL).is_some());
         // More points than nominals is no gap.
         assert_eq!(find_gap(&motion, &centres(&path, 0.4, 2), BALL), None);
+    }
+}
+
+/// `path` (see [`with_fan`]) with the lines round its sharp trailing edge fanned out from a pivot 1 mm inside it,
+/// aimed at a 1.5 mm ball's centres, as the plan probes them (`plan::fan`).
+fn with_fanned_lines(path: &KnownPath) -> KnownPath {
+    let trailing = edge(path, Edge::Trailing);
+    let n = path.surface.len();
+    let (from, to) = (
+        path.normals[(trailing + n - 1) % n],
+        path.normals[(trailing + 1) % n],
+    );
+    let apex = path.surface[trailing];
+    let sharp = crate::analysis::edges::SharpEdge {
+        apex: [apex.y, apex.z],
+        from_normal: [from.y, from.z],
+        turn_rad: (from.y * to.z - from.z * to.y).atan2(from.dot(&to)),
+    };
+    let xyz = |v: &Vector3<f64>| Xyz::new(v.x, v.y, v.z);
+    let nominals: Vec<Nominal> = path
+        .surface
+        .iter()
+        .zip(&path.normals)
+        .map(|(p, n)| Nominal {
+            point: xyz(&p.coords),
+            normal: xyz(n),
+        })
+        .collect();
+    let fanned = crate::plan::fan::fanned(&nominals, &[sharp], 1.0, 1.5);
+    KnownPath {
+        surface: fanned
+            .iter()
+            .map(|n| Point3::new(n.point.x, n.point.y, n.point.z))
+            .collect(),
+        normals: fanned
+            .iter()
+            .map(|n| Vector3::new(n.normal.x, n.normal.y, n.normal.z))
+            .collect(),
+        ..path.clone()
+    }
+}
+
+#[test]
+fn a_point_lost_on_a_fanned_line_round_a_sharp_edge_is_a_gap_there() {
+    // One point per nominal, the ball on each fanned line 0.4 mm beyond the master's: any one point or two lost
+    // round the edge, or just before or after it, is found where it was lost.
+    let path = with_fan(&naca_path(200), 16);
+    let trailing = edge(&path, Edge::Trailing);
+    let fanned = with_fanned_lines(&path);
+    let moved = (0..path.surface.len())
+        .filter(|&i| (fanned.surface[i] - path.surface[i]).norm() > 1e-9)
+        .count();
+    assert!(moved >= 14, "{moved} nominals fanned");
+    let motion = curve_motion_at(fanned.clone(), Density::AtNominals);
+    let whole = centres(&fanned, 0.4, 1);
+    assert_eq!(find_gap(&motion, &whole, BALL), None);
+    for lost in [1, 2] {
+        for from in trailing - 2..trailing + 18 {
+            let mut scan = whole.clone();
+            scan.drain(from..from + lost);
+            let gap = find_gap(&motion, &scan, BALL)
+                .unwrap_or_else(|| panic!("{lost} points lost at {from} (edge from {trailing})"));
+            assert_eq!(gap.after, Some(from - 1), "{lost} lost at {from}: {gap}");
+            assert!(gap.length_mm > 0.0, "{gap}");
+        }
     }
 }
 
