@@ -55,7 +55,7 @@ pub struct ScanMotion {
     /// The ball radius these positions are planned for, mm.
     pub ball_radius_mm: f64,
     /// A curve scan's sharp edges, whose probing lines fan out from a pivot inside them: what a stop there is
-    /// explained by. None for other scans.
+    /// explained by. Empty for other scans.
     pub edges: Vec<EdgeFan>,
 }
 
