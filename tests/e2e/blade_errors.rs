@@ -27,7 +27,7 @@ pub struct Injected {
     pub thickness_scale: f64,
     pub camber_scale: f64,
     /// How much thicker its section is than the master's 2 mm in from the leading edge and from the trailing edge
-    /// along its own chord, mm: the simulator's own outlines measured (see [`true_edge_thicknesses_mm`]). Not the
+    /// along its own chord, mm: the simulator's own outlines measured (see [`true_chord_and_edge_thicknesses_mm`]). Not the
     /// master's times `thickness_scale - 1`: more camber turns the nose, and 5-10 % more (blade C of
     /// propeller-shape-errors.toml) makes the leading edge's thickness 10.5-11.7 um more than the scale alone.
     pub edge_thickness_change_mm: [f64; 2],
@@ -51,18 +51,17 @@ fn nose(section: &impl ClosedCurve) -> (f64, nalgebra::Point2<f64>) {
         .expect("points round the outline")
 }
 
-/// The nose-tail chord of blade `blade`'s section at radius `r` (mm) as the simulator makes it (see [`nose`]).
-fn true_chord_mm(propeller: &Propeller, blade: usize, r: f64) -> f64 {
-    let section = propeller.section_curve(blade, r);
-    (nose(&section).1 - section.point(0.0)).norm()
-}
-
-/// The thicknesses of blade `blade`'s section at radius `r` as the simulator makes it, `in_mm` in from its nose
-/// and from its sharp trailing edge along its nose-tail chord, mm: the distance between the two faces' crossings
+/// The nose-tail chord of blade `blade`'s section at radius `r` as the simulator makes it (see [`nose`]), and its
+/// thicknesses `in_mm` in from its nose and from its sharp trailing edge along that chord, mm: the distance between the two faces' crossings
 /// of the line across the chord there, each found by bisecting the face's parameter (a face's points move
 /// monotonically along the chord from tail to nose). The station's definition (`section_parameters`), taken
 /// independently from the simulator's exact outline.
-fn true_edge_thicknesses_mm(propeller: &Propeller, blade: usize, r: f64, in_mm: f64) -> [f64; 2] {
+fn true_chord_and_edge_thicknesses_mm(
+    propeller: &Propeller,
+    blade: usize,
+    r: f64,
+    in_mm: f64,
+) -> (f64, [f64; 2]) {
     let section = propeller.section_curve(blade, r);
     let tail = section.point(0.0);
     let (nose_s, nose) = nose(&section);
@@ -85,7 +84,10 @@ fn true_edge_thicknesses_mm(propeller: &Propeller, blade: usize, r: f64, in_mm: 
         };
         (crossing((0.0, nose_s)) - crossing((1.0, nose_s))).norm()
     };
-    [thickness_at(in_mm), thickness_at(chord.norm() - in_mm)]
+    (
+        chord.norm(),
+        [thickness_at(in_mm), thickness_at(chord.norm() - in_mm)],
+    )
 }
 
 /// How far in from each edge the station takes the edge thicknesses, mm (its default).
@@ -102,18 +104,17 @@ pub fn injected(spec: &PropellerSpec, blade: usize, r: f64) -> Injected {
     let angle = (pitch / (TAU * r)).atan() + design_twist + at(error.twist_deg).to_radians();
     let local_pitch = |angle: f64| TAU * r * angle.tan();
     let propeller = Propeller::new(spec.clone()).expect("a valid propeller");
+    let measured =
+        |blade| true_chord_and_edge_thicknesses_mm(&propeller, blade, r, EDGE_DISTANCE_MM);
+    let ((chord, [le, te]), (chord0, [le0, te0])) = (measured(blade), measured(0));
     Injected {
         shift_mm: [r * error.index_deg.to_radians().tan(), at(error.shift_mm)],
         turn_deg: (angle - nominal_angle).to_degrees(),
         pitch_mm: (local_pitch(nominal_angle), local_pitch(angle)),
-        chord_change_mm: true_chord_mm(&propeller, blade, r) - true_chord_mm(&propeller, 0, r),
+        chord_change_mm: chord - chord0,
         thickness_scale: at(error.thickness_scale),
         camber_scale: at(error.camber_scale),
-        edge_thickness_change_mm: {
-            let [le, te] = true_edge_thicknesses_mm(&propeller, blade, r, EDGE_DISTANCE_MM);
-            let [le0, te0] = true_edge_thicknesses_mm(&propeller, 0, r, EDGE_DISTANCE_MM);
-            [le - le0, te - te0]
-        },
+        edge_thickness_change_mm: [le - le0, te - te0],
     }
 }
 
