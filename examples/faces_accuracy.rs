@@ -6,9 +6,10 @@
 //! of chord of the leading and of the trailing edge, the worst RMS, and the spread over draws (at each true point, the largest less the
 //! smallest signed distance over the draws, at worst).
 //!
-//!     cargo run --release --example faces_accuracy [-- DRAWS [DEGREE]]
+//!     cargo run --release --example faces_accuracy [-- DRAWS [FIRST_DRAW [DEGREE]]]
 //!
-//! DEGREE fixes every face's degree instead of choosing it by held-out points.
+//! The draws are seeded FIRST_DRAW (0 unless given) onwards; DEGREE fixes every face's degree instead of choosing
+//! it by held-out points.
 
 use nalgebra::Vector2;
 use rand::SeedableRng;
@@ -25,9 +26,10 @@ const CHORDS_MM: [f64; 2] = [100.0, 250.0];
 const POINTS: usize = 400;
 const SIGMA_MM: f64 = 0.002;
 
-/// Signed distances of the truth to each draw's model, one row per draw.
+/// Signed distances of the truth to each draw's model, one row per draw, with the draws' seeds.
 struct Campaign {
     rows: Vec<Vec<f64>>,
+    seeds: Vec<u64>,
 }
 
 impl Campaign {
@@ -39,6 +41,13 @@ impl Campaign {
                 .fold(0.0f64, |m, (d, _)| m.max(d.abs()))
         };
         let worst = worst_where(&|_| true);
+        let row_worst = |row: &Vec<f64>| row.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        let worst_seed = self
+            .rows
+            .iter()
+            .zip(&self.seeds)
+            .max_by(|a, b| row_worst(a.0).total_cmp(&row_worst(b.0)))
+            .map_or(0, |(_, seed)| *seed);
         let worst_at_nose = worst_where(&|p| p.x < 0.01 * chord);
         let worst_at_tail = worst_where(&|p| p.x > 0.99 * chord);
         let worst_rms = self
@@ -58,7 +67,7 @@ impl Campaign {
             })
             .fold(0.0, f64::max);
         format!(
-            "{:>8.1} | {:>8.1} | {:>8.1} | {:>6.2} | {:>8.1}",
+            "{:>8.1} (draw {worst_seed}) | {:>8.1} | {:>8.1} | {:>6.2} | {:>8.1}",
             worst * 1000.0,
             worst_at_nose * 1000.0,
             worst_at_tail * 1000.0,
@@ -72,13 +81,16 @@ fn main() {
     let draws: u64 = std::env::args()
         .nth(1)
         .map_or(20, |a| a.parse().expect("a number of draws"));
-    let degree: Option<usize> = std::env::args()
+    let first_draw: u64 = std::env::args()
         .nth(2)
+        .map_or(0, |a| a.parse().expect("the first draw's seed"));
+    let degree: Option<usize> = std::env::args()
+        .nth(3)
         .map(|a| a.parse().expect("a degree for every face"));
-    println!("{draws} draws of {POINTS} points, sigma {} um; distances of the true section to the model, um", SIGMA_MM * 1000.0);
+    println!("{draws} draws of {POINTS} points (seeds {first_draw} to {}), sigma {} um; distances of the true section to the model, um", first_draw + draws - 1, SIGMA_MM * 1000.0);
     println!();
-    println!("| section | chord (mm) | model | max | max within 1% of chord of the leading edge | of the trailing edge | worst RMS | spread over draws | faces' degrees |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("| section | chord (mm) | model | max (its draw) | max within 1% of chord of the leading edge | of the trailing edge | worst RMS | spread over draws | faces' edge off the true edge: RMS, most inward | faces' degrees |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for digits in SECTIONS {
         for chord in CHORDS_MM {
             let foil = Naca4::from_digits(digits, chord, true).expect("digits");
@@ -87,10 +99,18 @@ fn main() {
             let clean: Vec<Vector2<f64>> =
                 foil.points(POINTS).into_iter().map(Vector2::from).collect();
             let normals = ordered_profile_normals(&clean);
-            let mut faces = Campaign { rows: Vec::new() };
-            let mut single = Campaign { rows: Vec::new() };
+            let mut faces = Campaign {
+                rows: Vec::new(),
+                seeds: Vec::new(),
+            };
+            let mut single = Campaign {
+                rows: Vec::new(),
+                seeds: Vec::new(),
+            };
             let mut degrees = std::collections::BTreeMap::<String, usize>::new();
-            for draw in 0..draws {
+            // How far the faces' sharp edge lies from the true one along the chord, mm (- inward).
+            let mut edge_off = Vec::new();
+            for draw in first_draw..first_draw + draws {
                 let mut rng = rand::rngs::StdRng::seed_from_u64(draw);
                 let noise = Normal::new(0.0, SIGMA_MM).expect("sigma");
                 let measured: Vec<Vector2<f64>> = clean
@@ -111,6 +131,15 @@ fn main() {
                     .map(|f| f.model.degree().to_string())
                     .collect();
                 *degrees.entry(chosen.join("+")).or_default() += 1;
+                let edge = fitted
+                    .model
+                    .joins()
+                    .iter()
+                    .find(|join| join.sharp)
+                    .expect("the sharp trailing edge's join");
+                edge_off.push(edge.point[0] - chord);
+                faces.seeds.push(draw);
+                single.seeds.push(draw);
                 faces.rows.push(
                     truth
                         .iter()
@@ -136,13 +165,18 @@ fn main() {
             }
             eprintln!(" NACA {digits} at {chord} mm");
             let degrees: Vec<String> = degrees.iter().map(|(d, n)| format!("{d} x{n}")).collect();
+            let edge_rms =
+                (edge_off.iter().map(|d| d * d).sum::<f64>() / edge_off.len() as f64).sqrt();
+            let most_inward = edge_off.iter().copied().fold(0.0, f64::min);
             println!(
-                "| NACA {digits} | {chord} | faces | {} | {} |",
+                "| NACA {digits} | {chord} | faces | {} | {:.2}, {:+.2} | {} |",
                 faces.summary(&truth, chord),
+                edge_rms * 1000.0,
+                most_inward * 1000.0,
                 degrees.join(", ")
             );
             println!(
-                "| NACA {digits} | {chord} | one polynomial, degree 8 | {} | |",
+                "| NACA {digits} | {chord} | one polynomial, degree 8 | {} | | |",
                 single.summary(&truth, chord)
             );
         }

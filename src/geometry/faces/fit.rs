@@ -2,18 +2,34 @@
 
 use nalgebra::Vector2;
 
-use super::split::{face_normals, find_corners, orientation, perimeter, split_at_corners};
+use super::split::{
+    edge_angle, face_normals, find_corners, orientation, perimeter, split_at_corners,
+};
 use super::{meeting_point, trace_face, FacedProfile, FacesError, Join};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
 use crate::geometry::held_out::{choose_degree, degrees_to_try, rms_distance, CANDIDATE_DEGREES};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{project_to_zero_set, Aabb};
 
-/// How many times a sharp edge's own point counts in the fits of the faces that meet there. The edge is where
-/// the faces cross, and where they cross at a small angle (a thin trailing edge's 8 deg) an error of the faces
-/// across their length moves it along the edge's bisector 14 times as far; held to the measured edge, both faces
-/// cross within the probe's noise of it. (Measured on NACA 0006 sections: see BENCHMARKS.md.)
-const EDGE_WEIGHT: usize = 20;
+/// How many times a sharp edge's own point counts, at most, in the fits of the faces that meet there (see
+/// [`edge_weight`]).
+const MAX_EDGE_WEIGHT: f64 = 200.0;
+
+/// How many times a sharp edge's own point counts in the fits of the two faces that meet there at `angle_rad`:
+/// 1 / (2 sin^2(angle / 2)), at least once and at most [`MAX_EDGE_WEIGHT`].
+///
+/// The edge is where the faces cross, and where they cross at a small angle an error of the faces across their
+/// length moves it along the edge's bisector 1 / sin(angle / 2) times as far (14 times on NACA 0006's 8 deg);
+/// the edge's own point is the one measure of where along the bisector the edge lies. Its noise along the
+/// bisector moves it across each face by only sin(angle / 2) of it, so in a face's fit it deserves 1 / sin^2 the
+/// weight of a point whose noise lies across the face, and half that in each of the two faces it serves. Measured
+/// over 45 draws of 2 um (BENCHMARKS.md, issue 15, stop 51): a fixed weight of 20 put NACA 0006's edge 2.7 um RMS
+/// off the truth (the faces crossing up to 3 um farther in than its point), 60 put it 2.2 um off and the cambered
+/// sections' 2.0 (1.9 at 20), 200 2.1 on every section.
+fn edge_weight(angle_rad: f64) -> usize {
+    let weight = 0.5 / (0.5 * angle_rad).sin().powi(2);
+    weight.clamp(1.0, MAX_EDGE_WEIGHT).round() as usize
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FacesFitOptions {
@@ -62,17 +78,19 @@ pub fn fit_faces(
         let face_points: Vec<Vector2<f64>> = face.indices.iter().map(|&i| points[i]).collect();
         let normals = face_normals(points, &face.indices, perimeter);
         let last = face_points.len() - 1;
-        let sharp_ends: Vec<usize> = [(face.start.sharp, 0), (face.end.sharp, last)]
+        // Each sharp end's point in the face, and its weight.
+        let sharp_ends: Vec<(usize, usize)> = [(face.start, 0), (face.end, last)]
             .into_iter()
-            .filter_map(|(sharp, k)| sharp.then_some(k))
+            .filter(|(end, _)| end.sharp)
+            .map(|(end, k)| (k, edge_weight(edge_angle(points, end.at))))
             .collect();
         // Every `every`-th point, and each sharp end's point repeated so that the face passes through it (see
-        // [`EDGE_WEIGHT`]; as much as among all the points when fitted to every other one).
+        // [`edge_weight`]; as much as among all the points when fitted to every other one).
         let fit = |degree: usize, every: usize| {
-            let repeats = (EDGE_WEIGHT / every).saturating_sub(1);
-            let edges = sharp_ends
-                .iter()
-                .flat_map(|&k| std::iter::repeat_n((face_points[k], normals[k]), repeats));
+            let edges = sharp_ends.iter().flat_map(|&(k, weight)| {
+                let repeats = (weight / every).saturating_sub(1);
+                std::iter::repeat_n((face_points[k], normals[k]), repeats)
+            });
             let (p, n): (Vec<_>, Vec<_>) = face_points
                 .iter()
                 .zip(&normals)
@@ -90,7 +108,7 @@ pub fn fit_faces(
                 // Fitted to every other point, judged by the others (a sharp end's point is fitted, not judged).
                 let judged: Vec<Vector2<f64>> = (1..face_points.len())
                     .step_by(2)
-                    .filter(|k| !sharp_ends.contains(k))
+                    .filter(|k| sharp_ends.iter().all(|(end, _)| end != k))
                     .map(|k| face_points[k])
                     .collect();
                 for degree in CANDIDATE_DEGREES {

@@ -106,6 +106,26 @@ fn turn_at(points: &[Vector2<f64>], i: usize, span: f64, longest_step: f64) -> f
         .abs()
 }
 
+/// The span over which a profile's direction is measured, and the longest step across which it is: a stray point,
+/// and its neighbours, turn the profile by up to 180 deg too, over steps far longer than the scan's (a stray, named
+/// to the operator as such, not an edge).
+fn direction_scales(points: &[Vector2<f64>]) -> (f64, f64) {
+    let n = points.len();
+    let span = DIRECTION_SPAN * perimeter(points);
+    let mut steps: Vec<f64> = (0..n)
+        .map(|i| (points[(i + 1) % n] - points[i]).norm())
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    (span, (STRAY_STEPS * steps[n / 2]).max(span))
+}
+
+/// The angle between the two faces at the sharp edge at point `corner` (rad): 180 deg less the profile's turn
+/// there over a span either side, where both faces are nearly straight (a NACA 0006's trailing edge: 8 deg).
+pub(crate) fn edge_angle(points: &[Vector2<f64>], corner: usize) -> f64 {
+    let (span, longest_step) = direction_scales(points);
+    std::f64::consts::PI - turn_at(points, corner, span, longest_step)
+}
+
 /// The sharp edges of a closed profile whose points run along it: the indices where the direction turns by more
 /// than [`CORNER_TURN_RAD`] over a span either side, one per edge (the sharpest of the points within a span).
 pub(crate) fn find_corners(points: &[Vector2<f64>]) -> Vec<usize> {
@@ -113,16 +133,7 @@ pub(crate) fn find_corners(points: &[Vector2<f64>]) -> Vec<usize> {
     if n < 6 {
         return Vec::new();
     }
-    let span = DIRECTION_SPAN * perimeter(points);
-    // A stray point, and its neighbours, turn the profile by up to 180 deg too, over steps far longer than the
-    // scan's: a stray (named to the operator as such), not an edge.
-    let longest_step = {
-        let mut steps: Vec<f64> = (0..n)
-            .map(|i| (points[(i + 1) % n] - points[i]).norm())
-            .collect();
-        steps.sort_by(f64::total_cmp);
-        (STRAY_STEPS * steps[n / 2]).max(span)
-    };
+    let (span, longest_step) = direction_scales(points);
     // An edge turns the profile at a point: over an eighth of the span it turns nearly as far as over the whole.
     // A round nose turns it in proportion to the length (a thin section's nose turns it by more than 90 deg over
     // the span: NACA 0003's, of 0.1 mm radius at 100 mm chord, by 105-111 deg, and by 28-39 deg over an eighth;
@@ -273,6 +284,24 @@ mod tests {
                     find_corners(&points),
                     vec![0],
                     "NACA {digits} at {chord} mm, {count} points"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_symmetric_section_s_trailing_edge_angle_is_read_from_its_points() {
+        // NACA 00tt with the closed edge's coefficient: each face leaves the edge at a slope of 5 t (0.2969 / 2 -
+        // 0.1260 - 2 x 0.3516 + 3 x 0.2843 - 4 x 0.1036) = -1.21025 t.
+        for (digits, t) in [("0006", 0.06), ("0012", 0.12), ("0024", 0.24)] {
+            let exact = 2.0 * (1.21025f64 * t).atan();
+            for count in [400, 4000] {
+                let angle = edge_angle(&section(digits, 100.0, count), 0);
+                assert!(
+                    (angle - exact).abs() < 0.2f64.to_radians(),
+                    "NACA {digits}, {count} points: {} deg, the section's {} deg",
+                    angle.to_degrees(),
+                    exact.to_degrees()
                 );
             }
         }
