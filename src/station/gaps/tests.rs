@@ -261,6 +261,24 @@ fn a_teach_scan_spaced_by_turn_is_a_gap_where_points_are_lost_round_a_roll_and_n
     assert_eq!(find_gap(&spaced, &stepped, BALL), None);
 }
 
+/// Drops `lost` points of a whole scan at each of `froms` in turn: each loss is a gap found after the point
+/// before it, with a length.
+fn assert_losses_found_where_lost(
+    motion: &ScanMotion,
+    whole: &[Point3<f64>],
+    lost: usize,
+    froms: impl IntoIterator<Item = usize>,
+) {
+    for from in froms {
+        let mut scan = whole.to_vec();
+        scan.drain(from..from + lost);
+        let gap =
+            find_gap(motion, &scan, BALL).unwrap_or_else(|| panic!("{lost} points lost at {from}"));
+        assert_eq!(gap.after, Some(from - 1), "{lost} lost at {from}: {gap}");
+        assert!(gap.length_mm > 0.0, "{gap}");
+    }
+}
+
 #[test]
 fn a_single_point_lost_anywhere_from_a_scan_at_its_nominals_is_a_gap_there() {
     // One point per nominal (the station's curve scans), the surface 0.4 mm off the nominal, entered at the top
@@ -274,14 +292,12 @@ fn a_single_point_lost_anywhere_from_a_scan_at_its_nominals_is_a_gap_there() {
         whole.rotate_left(entry);
         assert_eq!(find_gap(&motion, &whole, BALL), None);
         for lost in [1, 2] {
-            for from in [1, 17, 99, 100, 150, whole.len() - lost] {
-                let mut scan = whole.clone();
-                scan.drain(from..from + lost);
-                let gap = find_gap(&motion, &scan, BALL)
-                    .unwrap_or_else(|| panic!("{lost} points lost at {from}"));
-                assert_eq!(gap.after, Some(from - 1), "{lost} lost at {from}: {gap}");
-                assert!(gap.length_mm > 0.0, "{gap}");
-            }
+            assert_losses_found_where_lost(
+                &motion,
+                &whole,
+                lost,
+                [1, 17, 99, 100, 150, whole.len() - lost],
+            );
             let gap = find_gap(&motion, &whole[lost..], BALL).expect("the first points lost");
             assert_eq!(gap.after, None, "{gap}");
         }
@@ -345,14 +361,7 @@ fn a_point_lost_on_a_fanned_line_round_a_sharp_edge_is_a_gap_there() {
     let whole = centres(&fanned, 0.4, 1);
     assert_eq!(find_gap(&motion, &whole, BALL), None);
     for lost in [1, 2] {
-        for from in trailing - 2..trailing + 18 {
-            let mut scan = whole.clone();
-            scan.drain(from..from + lost);
-            let gap = find_gap(&motion, &scan, BALL)
-                .unwrap_or_else(|| panic!("{lost} points lost at {from} (edge from {trailing})"));
-            assert_eq!(gap.after, Some(from - 1), "{lost} lost at {from}: {gap}");
-            assert!(gap.length_mm > 0.0, "{gap}");
-        }
+        assert_losses_found_where_lost(&motion, &whole, lost, trailing - 2..trailing + 18);
     }
 }
 
