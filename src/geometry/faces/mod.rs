@@ -14,6 +14,7 @@
 //! (half a piece's length and twice its sag) that proves no other piece lies nearer.
 
 mod fit;
+mod loft;
 mod split;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -27,6 +28,7 @@ use super::nearest::PointIndex;
 use super::sampling::{project_to_zero_set, Aabb};
 
 pub use fit::{fit_faces, FacesFitOptions, FittedFaces};
+pub use loft::{check as check_stack, FacedLoft, FacedSection, FacedStackError};
 
 /// Spacing of the traced faces' points, mm: short enough that a piece's sag is nanometres on a nose of 0.4 mm
 /// radius (0.02^2 / 8 / 0.4 = 0.1 um), and the bound that proves a foot stays tight.
