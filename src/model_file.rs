@@ -7,7 +7,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::fsutil::write_atomically;
-use crate::geometry::faces::{FacedProfile, FacesError, FittedFaces, Join};
+use crate::geometry::faces::{
+    check_stack, FacedProfile, FacedSection, FacesError, FittedFaces, Join,
+};
 use crate::geometry::fit3l::{FitStats, Fitted};
 use crate::geometry::implicit::IpModel;
 use crate::geometry::interp::{Profile, ProfileStack, StackError};
@@ -52,6 +54,10 @@ pub enum ReferenceModel {
     /// joined where they meet (`geometry::faces`).
     #[serde(rename = "ip-faces")]
     Faces(FacedIp),
+    /// Parallel profiles along x, each split at its sharp edges into faces, each face lofted to the same face of
+    /// the next profile (`geometry::faces::FacedLoft`): the sharp edges run as creases from profile to profile.
+    #[serde(rename = "ip-faces-stack")]
+    FacesStack { profiles: Vec<FacedStackProfile> },
     /// A CSG tree of supershapes (seeds 000 and 001) with the statistics of its fit.
     #[serde(rename = "supershape")]
     Supershape {
@@ -213,6 +219,27 @@ impl FacedIp {
     }
 }
 
+/// One profile of a stack of faces: its position along x (mm) and its faces in the (y, z) plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FacedStackProfile {
+    pub x: f64,
+    pub profile: FacedIp,
+}
+
+/// A stack of faces' profiles as the loft takes them.
+pub fn faced_sections(profiles: &[FacedStackProfile]) -> Vec<FacedSection> {
+    profiles
+        .iter()
+        .map(|p| FacedSection {
+            x: p.x,
+            faces: p.profile.faces.iter().map(|f| f.ip.clone()).collect(),
+            joins: p.profile.joins.clone(),
+            domain: p.profile.domain(),
+        })
+        .collect()
+}
+
 /// One profile of a stack: its position along x (mm) and its fitted (y, z) model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -269,21 +296,28 @@ impl ModelFile {
         let checked = match &file.model {
             ReferenceModel::Profile(m) => m.check(),
             ReferenceModel::Surface(m) => m.check(),
-            ReferenceModel::Stack { profiles } => profiles
-                .iter()
-                .enumerate()
-                .try_for_each(|(i, p)| {
-                    p.fitted
-                        .check()
-                        .map_err(|e| format!("profile {i} (x = {} mm): {e}", p.x))
-                })
-                .and_then(|()| stack_of(profiles).map(drop).map_err(|e| e.to_string())),
+            ReferenceModel::Stack { profiles } => {
+                each_profile(profiles.iter().map(|p| (p.x, p.fitted.check())))
+                    .and_then(|()| stack_of(profiles).map(drop).map_err(|e| e.to_string()))
+            }
             ReferenceModel::Supershape { solid, .. } => check_solid(solid),
             ReferenceModel::Faces(faced) => faced.check(),
+            ReferenceModel::FacesStack { profiles } => {
+                each_profile(profiles.iter().map(|p| (p.x, p.profile.check()))).and_then(|()| {
+                    check_stack(&mut faced_sections(profiles)).map_err(|e| e.to_string())
+                })
+            }
         };
         checked.map_err(|problem| ModelFileError::new(path, problem))?;
         Ok(file)
     }
+}
+
+/// A stack's profiles' own checks, (x, verdict) in file order: the first problem, naming its profile.
+fn each_profile(checks: impl Iterator<Item = (f64, Result<(), String>)>) -> Result<(), String> {
+    checks.enumerate().try_for_each(|(i, (x, checked))| {
+        checked.map_err(|e| format!("profile {i} (x = {x} mm): {e}"))
+    })
 }
 
 /// The piecewise 3-D model of a stack's profiles.

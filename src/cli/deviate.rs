@@ -1,12 +1,12 @@
 //! `zeroset deviate`: signed deviations of measured points from a reference model, written to a CSV file with a
 //! summary on the terminal.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::anyhow;
 use clap::Args;
-use nalgebra::SVector;
+use nalgebra::{SVector, Vector3};
 use rayon::prelude::*;
 
 use super::DistanceArg;
@@ -15,10 +15,11 @@ use crate::geometry::distance::{
     signed_distances, DistanceError, DistanceMethod, ExactDistance, StackDistance,
     CERTIFICATE_TOLERANCE_MM,
 };
+use crate::geometry::faces::FacedLoft;
 use crate::geometry::implicit::Implicit;
 use crate::geometry::sampling::{Aabb, ZeroSetSamples};
 use crate::geometry::supershape::distance::SolidDistance;
-use crate::model_file::{stack_of, ModelFile, ReferenceModel};
+use crate::model_file::{faced_sections, stack_of, ModelFile, ReferenceModel};
 use crate::points::{read_point_file, PointSet};
 
 /// Zero-set sampling for exact-distance seeds: cells along the longest side of twice the model's data box.
@@ -55,104 +56,127 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
     };
     // Feet the exact distance's certificate left unproved, where the model has one (implicit polynomials).
     let mut unproved = None;
-    let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) = match (
-        &file.model,
-        points,
-    ) {
-        (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
-            let range = m.domain.scaled(RANGE);
-            let distances = within(&range, p, |p| {
-                distances_to(&m.ip, &range, PROFILE_CELLS, p, method, &mut unproved)
-            });
-            (coordinates(p), distances)
-        }
-        (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
-            let range = m.domain.scaled(RANGE);
-            let distances = within(&range, p, |p| {
-                distances_to(&m.ip, &range, SURFACE_CELLS, p, method, &mut unproved)
-            });
-            (coordinates(p), distances)
-        }
-        (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
-            let stack = stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
-            // The stack sorts its profiles along x; pair each with its own domain in that order.
-            let mut sorted = profiles.clone();
-            sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
-            let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
-            let range = stack.bounds(&domains).scaled(RANGE);
-            let reach = 2.0 * range.diagonal();
-            let distances = within(&range, p, |p| {
-                signed_distances(&stack, p, method, reach, |points| {
-                    let exact = StackDistance::new(&stack, &domains);
-                    // Each point's foot is searched and proved on its own: in parallel.
-                    let distances = points
-                        .par_iter()
-                        .map(|q| exact.foot(q).map(|f| f.distance))
-                        .collect();
-                    unproved = Some(exact.uncertified());
-                    distances
-                })
-            });
-            (coordinates(p), distances)
-        }
-        (ReferenceModel::Supershape { solid, .. }, PointSet::Spatial(p)) => {
-            if method != DistanceMethod::Exact {
-                anyhow::bail!(
-                    "{}: a supershape model is measured by the exact Euclidean distance only; \
-                         leave out --distance or give --distance exact",
-                    args.model.display()
-                );
+    let (rows, distances): (Vec<Vec<f64>>, Vec<Result<f64, DistanceError>>) =
+        match (&file.model, points) {
+            (ReferenceModel::Profile(m), PointSet::Profile(p)) => {
+                let range = m.domain.scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    distances_to(&m.ip, &range, PROFILE_CELLS, p, method, &mut unproved)
+                });
+                (coordinates(p), distances)
             }
-            let exact = SolidDistance::new(solid);
-            let bounds = solid.bounds();
-            let range = Aabb {
-                min: bounds.min.coords,
-                max: bounds.max.coords,
+            (ReferenceModel::Surface(m), PointSet::Spatial(p)) => {
+                let range = m.domain.scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    distances_to(&m.ip, &range, SURFACE_CELLS, p, method, &mut unproved)
+                });
+                (coordinates(p), distances)
             }
-            .scaled(RANGE);
-            let distances = within(&range, p, |p| {
-                p.iter()
-                    .map(|q| {
-                        exact
-                            .foot(&nalgebra::Point3::from(*q))
-                            .map(|f| f.distance_mm)
-                            .ok_or(DistanceError::NoFootPoint)
+            (ReferenceModel::Stack { profiles }, PointSet::Spatial(p)) => {
+                let stack =
+                    stack_of(profiles).map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+                // The stack sorts its profiles along x; pair each with its own domain in that order.
+                let mut sorted = profiles.clone();
+                sorted.sort_by(|a, b| a.x.total_cmp(&b.x));
+                let domains: Vec<Aabb<2>> = sorted.iter().map(|p| p.fitted.domain).collect();
+                let range = stack.bounds(&domains).scaled(RANGE);
+                let reach = 2.0 * range.diagonal();
+                let distances = within(&range, p, |p| {
+                    signed_distances(&stack, p, method, reach, |points| {
+                        let exact = StackDistance::new(&stack, &domains);
+                        // Each point's foot is searched and proved on its own: in parallel.
+                        let distances = points
+                            .par_iter()
+                            .map(|q| exact.foot(q).map(|f| f.distance))
+                            .collect();
+                        unproved = Some(exact.uncertified());
+                        distances
                     })
-                    .collect()
-            });
-            (coordinates(p), distances)
-        }
-        (ReferenceModel::Faces(faced), PointSet::Profile(p)) => {
-            if method != DistanceMethod::Exact {
-                anyhow::bail!(
-                        "{}: a profile of faces is measured by the exact Euclidean distance only (its sharp edges \
-                         have no first-order estimate); leave out --distance or give --distance exact",
-                        args.model.display()
-                    );
+                });
+                (coordinates(p), distances)
             }
-            let profile = faced
-                .profile()
-                .map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
-            let range = faced.domain().scaled(RANGE);
-            // Every foot the faces give is proved nearest by the traced faces' bound, or there is none.
-            unproved = Some(0);
-            let distances = within(&range, p, |p| {
-                p.iter()
-                    .map(|q| {
-                        profile
-                            .foot(q)
-                            .map(|f| f.distance)
-                            .ok_or(DistanceError::NoFootPoint)
+            (ReferenceModel::Supershape { solid, .. }, PointSet::Spatial(p)) => {
+                exact_only(method, &args.model, "a supershape model")?;
+                let exact = SolidDistance::new(solid);
+                let bounds = solid.bounds();
+                let range = Aabb {
+                    min: bounds.min.coords,
+                    max: bounds.max.coords,
+                }
+                .scaled(RANGE);
+                let distances = within(&range, p, |p| {
+                    p.iter()
+                        .map(|q| {
+                            exact
+                                .foot(&nalgebra::Point3::from(*q))
+                                .map(|f| f.distance_mm)
+                                .ok_or(DistanceError::NoFootPoint)
+                        })
+                        .collect()
+                });
+                (coordinates(p), distances)
+            }
+            (ReferenceModel::Faces(faced), PointSet::Profile(p)) => {
+                exact_only(
+                    method,
+                    &args.model,
+                    "a profile of faces (its sharp edges have no first-order estimate)",
+                )?;
+                let profile = faced
+                    .profile()
+                    .map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+                let range = faced.domain().scaled(RANGE);
+                // Every foot the faces give is proved nearest by the traced faces' bound, or there is none.
+                unproved = Some(0);
+                let distances = within(&range, p, |p| {
+                    p.iter()
+                        .map(|q| {
+                            profile
+                                .foot(q)
+                                .map(|f| f.distance)
+                                .ok_or(DistanceError::NoFootPoint)
+                        })
+                        .collect()
+                });
+                (coordinates(p), distances)
+            }
+            (ReferenceModel::FacesStack { profiles }, PointSet::Spatial(p)) => {
+                exact_only(
+                    method,
+                    &args.model,
+                    "a stack of faces (its sharp edges have no first-order estimate)",
+                )?;
+                let loft = FacedLoft::new(faced_sections(profiles))
+                    .map_err(|e| anyhow!("{}: {e}", args.model.display()))?;
+                let (first, last) = loft.span();
+                let yz = profiles
+                    .iter()
+                    .map(|p| p.profile.domain())
+                    .reduce(|a, b| Aabb {
+                        min: a.min.inf(&b.min),
+                        max: a.max.sup(&b.max),
                     })
-                    .collect()
-            });
-            (coordinates(p), distances)
-        }
-        (ReferenceModel::Profile(_) | ReferenceModel::Faces(_), PointSet::Spatial(_)) => {
-            return Err(mismatch("a profile", "y,z", "x,y,z"))
-        }
-        (_, PointSet::Profile(_)) => return Err(mismatch("3-D", "x,y,z", "y,z")),
-    };
+                    .expect("a stack has profiles")
+                    .scaled(2.0);
+                let range = Aabb {
+                    min: Vector3::new(first, yz.min.x, yz.min.y),
+                    max: Vector3::new(last, yz.max.x, yz.max.y),
+                }
+                .scaled(RANGE);
+                // The nearest of the loft's triangles, found by the R*-tree's bounds: every foot is the nearest.
+                unproved = Some(0);
+                let distances = within(&range, p, |p| {
+                    p.par_iter()
+                        .map(|q| loft.foot(q).map(|f| f.distance))
+                        .collect()
+                });
+                (coordinates(p), distances)
+            }
+            (ReferenceModel::Profile(_) | ReferenceModel::Faces(_), PointSet::Spatial(_)) => {
+                return Err(mismatch("a profile", "y,z", "x,y,z"))
+            }
+            (_, PointSet::Profile(_)) => return Err(mismatch("3-D", "x,y,z", "y,z")),
+        };
     let header: &[&str] = if rows[0].len() == 2 {
         &["y", "z"]
     } else {
@@ -177,6 +201,18 @@ pub fn run(args: &DeviateArgs) -> anyhow::Result<()> {
         args.out.display(),
         started.elapsed().as_secs_f64()
     )?;
+    Ok(())
+}
+
+/// Models with no first-order distance estimate (sharp edges, CSG) are measured by the exact distance only.
+fn exact_only(method: DistanceMethod, model: &Path, what: &str) -> anyhow::Result<()> {
+    if method != DistanceMethod::Exact {
+        anyhow::bail!(
+            "{}: {what} is measured by the exact Euclidean distance only; leave out --distance or give --distance \
+             exact",
+            model.display()
+        );
+    }
     Ok(())
 }
 

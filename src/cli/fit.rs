@@ -9,14 +9,16 @@ use nalgebra::{SVector, Vector2, Vector3};
 
 use super::{rows_of, MethodArg};
 use crate::analysis::fit_sanity;
-use crate::geometry::faces::{fit_faces, FacesFitOptions};
+use crate::geometry::faces::{fit_faces, FacedLoft, FacesFitOptions};
 use crate::geometry::fit3l::{fit_ip, FitMethod, FitOptions, Fitted};
 use crate::geometry::held_out::{
     choose_degree, clean_fit_or_chosen, combined_scores, held_out_scores, CANDIDATE_DEGREES,
 };
 use crate::geometry::nearest::PointIndex;
 use crate::geometry::normals::{ordered_profile_normals, pca_normals};
-use crate::model_file::{FacedIp, FittedIp, ModelFile, ReferenceModel, StackProfile};
+use crate::model_file::{
+    faced_sections, FacedIp, FacedStackProfile, FittedIp, ModelFile, ReferenceModel, StackProfile,
+};
 use crate::points::{read_point_file, PointFile, PointSet};
 
 #[derive(Args)]
@@ -30,9 +32,10 @@ pub struct FitIpArgs {
     /// (points in parallel planes of constant x) takes 4.
     #[arg(long, value_parser = degree)]
     degree: Option<usize>,
-    /// Sharp edges of a planar profile (a blade's trailing edge): `auto` finds them in the points (which must run
-    /// along the profile) and fits the faces between them one by one, joined at the edges; `none` fits one
-    /// polynomial round the whole profile, which rounds or overshoots a sharp edge by tens of microns.
+    /// Sharp edges of a planar profile, or of each profile of a stack (a blade's trailing edge): `auto` finds them
+    /// in the points (which must run along the profile) and fits the faces between them one by one, joined at the
+    /// edges, a stack's faces lofted from profile to profile; `none` fits one polynomial round the whole profile,
+    /// which rounds or overshoots a sharp edge by tens of microns.
     #[arg(long, value_enum, default_value = "auto")]
     edges: EdgesArg,
     #[arg(long, value_enum, default_value = "odr")]
@@ -41,7 +44,7 @@ pub struct FitIpArgs {
     #[arg(long, value_enum, default_value = "auto")]
     normals: NormalsArg,
     /// Treat x,y,z points as parallel planar profiles at constant x and fit a stack of profile models blended
-    /// along x (seed 003 section 4).
+    /// along x (seed 003 section 4), or, where every profile has sharp edges, lofted face by face.
     #[arg(long)]
     stack: bool,
     /// Points whose x differ by less than this (mm) belong to the same profile plane (with --stack).
@@ -103,7 +106,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let lines = &file.lines;
     let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
-            match fit_faces_of(args, &points)? {
+            match fit_faces_of(args, &args.points.display().to_string(), &points)? {
                 Some(faced) => (ReferenceModel::Faces(faced), method),
                 None => one_polynomial(args, &points, lines)?,
             }
@@ -157,8 +160,13 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
             )
         }
         (PointSet::Spatial(points), true) => {
-            let profiles = fit_stack(&args.points, &points, lines, method, args)?;
-            (ReferenceModel::Stack { profiles }, method)
+            match fit_faces_stack(&args.points, &points, lines, args)? {
+                Some(profiles) => (ReferenceModel::FacesStack { profiles }, method),
+                None => {
+                    let profiles = fit_stack(&args.points, &points, lines, method, args)?;
+                    (ReferenceModel::Stack { profiles }, method)
+                }
+            }
         }
         (PointSet::Profile(_), true) => {
             bail!(
@@ -190,9 +198,14 @@ fn with_faces(args: &FitIpArgs, points: &[Vector2<f64>]) -> bool {
         && runs_along_the_profile(points)
 }
 
-/// The profile fitted face by face between its sharp edges, with what was found and fitted said; `None` when it
-/// has no sharp edge. A fit that misses `--tolerance` fails rather than being saved.
-fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Option<FacedIp>> {
+/// The profile fitted face by face between its sharp edges, with what was found and fitted said after `label`
+/// (the file, or a stack's profile); `None` when it has no sharp edge. A fit that misses `--tolerance` fails
+/// rather than being saved.
+fn fit_faces_of(
+    args: &FitIpArgs,
+    label: &str,
+    points: &[Vector2<f64>],
+) -> anyhow::Result<Option<FacedIp>> {
     let options = FacesFitOptions {
         degree: args.degree,
         method: args.method.into(),
@@ -200,7 +213,7 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
     let Some(fitted) = fit_faces(points, &options).map_err(|e| {
         anyhow!(
             "{}: {e}; check the points there, or fit one polynomial round the whole profile with --edges none",
-            args.points.display()
+            label
         )
     })?
     else {
@@ -216,7 +229,7 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
     reportln!(
         "{}: {} sharp edge(s) at {} mm: fitted face by face, {} faces joined at the edges (--edges none for one \
          polynomial)",
-        args.points.display(),
+        label,
         edges.len(),
         edges.join(", "),
         fitted.faces.len()
@@ -267,7 +280,7 @@ fn fit_faces_of(args: &FitIpArgs, points: &[Vector2<f64>]) -> anyhow::Result<Opt
             bail!(
                 "{}: the faces' fit reaches {:.4} mm at worst, beyond the part's tolerance of {tolerance} mm: no \
                  model saved; check the points for strays, or give --degree",
-                args.points.display(),
+                label,
                 stats.max_distance_mm
             );
         }
@@ -398,6 +411,74 @@ fn profile_normals(
     } else {
         pca_normals(points)
     })
+}
+
+/// A stack whose profiles have sharp edges: each profile fitted face by face (each face's degree its own, as for
+/// one profile), the faces lofted from profile to profile. `None` where edges are not looked for (`--edges none`,
+/// `--normals pca`, points that do not run along their profiles) or no profile has one: one polynomial per profile
+/// then serves. Profiles some with sharp edges and some without cannot be lofted face to face, and fail.
+fn fit_faces_stack(
+    path: &Path,
+    points: &[Vector3<f64>],
+    lines: &[u64],
+    args: &FitIpArgs,
+) -> anyhow::Result<Option<Vec<FacedStackProfile>>> {
+    let planes = group_into_planes(points, args.plane_tolerance);
+    let profiles: Vec<(f64, Vec<Vector2<f64>>, String)> = planes
+        .iter()
+        .map(|(x, indices)| {
+            let yz = indices
+                .iter()
+                .map(|&i| Vector2::new(points[i].y, points[i].z))
+                .collect();
+            let rows = rows_of(path, lines, indices.iter().copied());
+            (*x, yz, format!("{rows}: the profile at x = {x:.3} mm"))
+        })
+        .collect();
+    let looked_for = profiles.len() >= 2 && profiles.iter().all(|(_, yz, _)| with_faces(args, yz));
+    if !looked_for {
+        return Ok(None);
+    }
+    let mut fitted = Vec::with_capacity(profiles.len());
+    for (x, yz, label) in &profiles {
+        fitted.push((*x, fit_faces_of(args, label, yz)?));
+    }
+    let without: Vec<String> = fitted
+        .iter()
+        .filter(|(_, faced)| faced.is_none())
+        .map(|(x, _)| format!("{x:.3}"))
+        .collect();
+    if without.len() == fitted.len() {
+        return Ok(None);
+    }
+    if !without.is_empty() {
+        bail!(
+            "{}: the profiles at x = {} mm have no sharp edge while the others have: a stack is lofted face to face \
+             between like profiles; check those profiles' points, or fit one polynomial per profile with --edges \
+             none",
+            path.display(),
+            without.join(", ")
+        );
+    }
+    let profiles: Vec<FacedStackProfile> = fitted
+        .into_iter()
+        .filter_map(|(x, faced)| Some(FacedStackProfile { x, profile: faced? }))
+        .collect();
+    let loft = FacedLoft::new(faced_sections(&profiles)).map_err(|e| {
+        anyhow!(
+            "{}: {e}; check the profiles' points, or fit one polynomial per profile with --edges none",
+            path.display()
+        )
+    })?;
+    reportln!(
+        "stack of faces: {} profiles, each face lofted through the same face of every profile ({} triangles, within \
+         {:.2} um of the faces' curves and {:.2} um of the smooth loft between them)",
+        profiles.len(),
+        loft.triangle_count(),
+        loft.sag_mm * 1000.0,
+        loft.surface_mm * 1000.0
+    )?;
+    Ok(Some(profiles))
 }
 
 /// A stack: one polynomial per plane of constant x, every one at the same degree (profiles blend only at equal

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::support::zeroset;
+use crate::support::{config, zeroset};
 
 /// Fits a point file with the given text and returns the single error line (asserting there is exactly one).
 fn fit_error(text: &str, degree: &str) -> String {
@@ -112,6 +112,22 @@ fn a_stack_profile_s_error_names_that_profile_and_its_own_lines() {
         fit_error_with(&text, &["--stack", "--degree", "4"]),
         "error: DIR/points.csv: lines 32-43: the profile at x = 200.000 mm: 12 points are too few for a degree-4 \
          fit (it has 15 coefficients; give at least 15 points)"
+    );
+}
+
+#[test]
+fn a_stack_of_profiles_some_with_sharp_edges_and_some_without_names_the_planes_without() {
+    // The blade's root profile (sharp trailing edge, lines 2-401) and a circle at x = 250 mm.
+    let blade = std::fs::read_to_string(config("profiles/naca-blade-a-5-profiles.csv")).unwrap();
+    let mut text: String = blade.lines().take(401).map(|l| format!("{l}\n")).collect();
+    for line in circle_csv(200).lines().skip(1) {
+        text.push_str(&format!("250,{line}\n"));
+    }
+    assert_eq!(
+        fit_error_with(&text, &["--stack"]),
+        "error: DIR/points.csv: the profiles at x = 250.000 mm have no sharp edge while the others have: a stack \
+         is lofted face to face between like profiles; check those profiles' points, or fit one polynomial per \
+         profile with --edges none"
     );
 }
 
