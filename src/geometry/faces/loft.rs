@@ -170,6 +170,7 @@ impl FacedLoft {
             let steps = steps_along_x(&rings[k], &rings[k + 1]).max(for_bend).max(1);
             let kept = thinned(&rings[k], &rings[k + 1], &starts, steps);
             for pair in kept.windows(2) {
+                // The piece across a join lies on no one face: the smooth joint's gap, or none at a sharp edge.
                 if starts.contains(&pair[1]) {
                     continue;
                 }
@@ -402,8 +403,8 @@ fn steps_along_x(ring_a: &[Vector2<f64>], ring_b: &[Vector2<f64>]) -> usize {
 
 /// The ring points kept (indices, both rings alike): from each one kept, the farthest next that every point
 /// between lies within [`THIN_TOLERANCE_MM`] of the chords to, in both rings, and whose quads twist by no more
-/// than that out of their triangles; every face's first point (a join) is kept. A blade's flanks, nearly straight,
-/// keep a point every tenth of a millimetre or so; its nose and edges every 0.02 mm.
+/// than that out of their triangles; every face's first and last points (its joins) are kept. A blade's flanks,
+/// nearly straight, keep a point every tenth of a millimetre or so; its nose and edges every 0.02 mm.
 fn thinned(
     ring_a: &[Vector2<f64>],
     ring_b: &[Vector2<f64>],
@@ -430,15 +431,18 @@ fn thinned(
                     && off_chord(ring_b, from, to, i) <= THIN_TOLERANCE_MM
             })
     };
+    // Every face's first and last point: its joins (at a sharp edge the edge itself, in both faces).
+    let mut ends = vec![false; n];
+    for &start in starts {
+        ends[start] = true;
+        ends[start.saturating_sub(1)] = true;
+    }
+    ends[n - 1] = true;
     let mut kept = vec![0];
     let mut from = 0;
     while from + 1 < n {
         let mut to = from + 1;
-        while to + 1 < n
-            && to + 1 - from <= MAX_THINNED_SPAN
-            && !starts.contains(&to)
-            && fits(from, to + 1)
-        {
+        while to + 1 < n && to + 1 - from <= MAX_THINNED_SPAN && !ends[to] && fits(from, to + 1) {
             to += 1;
         }
         kept.push(to);
