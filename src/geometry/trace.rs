@@ -69,6 +69,20 @@ pub fn resample_closed(points: &[Vector2<f64>], count: usize) -> Vec<Vector2<f64
     out
 }
 
+/// Whether `p` lies inside the closed polygon (crossing number: a ray from `p` along +x crosses its sides an odd
+/// number of times).
+pub(crate) fn inside_closed(polygon: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
+    let n = polygon.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
 /// The vertices of the closed polyline `points` that keep it within `tolerance` of itself (Douglas-Peucker on
 /// each half, split at the vertex farthest from the first): a finely traced curve kept dense only where it bends,
 /// its sharp corners kept exactly.

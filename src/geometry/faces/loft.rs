@@ -31,6 +31,7 @@ use crate::geometry::implicit::IpModel;
 use crate::geometry::sampling::{project_to_zero_set, Aabb};
 use crate::geometry::sweep::mesh::MeshPart;
 use crate::geometry::sweep::part::PartDistance;
+use crate::geometry::trace::inside_closed;
 
 /// The longest piece of a ring, mm: the faces are traced every 0.02 mm, and resampled no coarser.
 const RING_STEP_MM: f64 = 0.02;
@@ -232,18 +233,7 @@ impl FacedLoft {
             .find(|s| x <= s.b)
             .unwrap_or(&self.segments[self.segments.len() - 1]);
         let ring: Vec<Vector2<f64>> = segment.ring_at(x).collect();
-        let (y, z) = (q.y, q.z);
-        let mut inside = false;
-        for (i, p) in ring.iter().enumerate() {
-            let r = ring[(i + 1) % ring.len()];
-            if (p.y > z) != (r.y > z) {
-                let crossing = p.x + (z - p.y) / (r.y - p.y) * (r.x - p.x);
-                if y < crossing {
-                    inside = !inside;
-                }
-            }
-        }
-        inside
+        inside_closed(&ring, &Vector2::new(q.y, q.z))
     }
 }
 

@@ -5,6 +5,7 @@ use zeroset_sim::naca::Naca4;
 use super::*;
 use crate::geometry::fit3l::tests::with_probe_noise;
 use crate::geometry::fit3l::FitMethod;
+use crate::geometry::trace::inside_closed;
 
 const AUTO: FacesFitOptions = FacesFitOptions {
     degree: None,
@@ -88,22 +89,6 @@ fn a_profile_without_a_sharp_edge_has_no_faces() {
     assert!(fit_faces(&ellipse, &AUTO).unwrap().is_none());
 }
 
-/// Whether `p` is inside the closed polygon (crossing number).
-fn inside(polygon: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
-    let n = polygon.len();
-    let mut crossings = 0;
-    for i in 0..n {
-        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if x > p.x {
-                crossings += 1;
-            }
-        }
-    }
-    crossings % 2 == 1
-}
-
 /// Checks the exact distance of 3000 points within 5 mm of a faced NACA section (fitted to the draw `seed`), a third
 /// of them round the trailing edge, against a dense independent reference: within 1e-6 mm, on the right side, and
 /// every foot proved.
@@ -165,7 +150,11 @@ fn distances_match_a_dense_reference(digits: &str, chord: f64, seed: u64) {
             foot.distance
         );
         if refined > 1e-4 {
-            let expected = if inside(&outline, &p) { -1.0 } else { 1.0 };
+            let expected = if inside_closed(&outline, &p) {
+                -1.0
+            } else {
+                1.0
+            };
             assert_eq!(
                 foot.distance.signum(),
                 expected,

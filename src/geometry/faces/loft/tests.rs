@@ -6,6 +6,7 @@ use super::*;
 use crate::geometry::faces::{fit_faces, FacesFitOptions};
 use crate::geometry::fit3l::tests::with_probe_noise;
 use crate::geometry::fit3l::FitMethod;
+use crate::geometry::trace::inside_closed;
 
 /// The blade the tests measure: NACA 2412 sections with sharp trailing edges from x = 0 to 30 mm, the chord
 /// shrinking from 20 to 17 mm and the section turning by 6 deg about its quarter chord.
@@ -197,7 +198,7 @@ fn the_loft_s_distances_are_the_nearest_of_every_triangle_and_signed_by_its_sect
         );
         // The sign, against the true section (the loft lies within microns of it): a point well inside or
         // outside it reads so.
-        let truth_inside = winding_inside(&section, &Vector2::new(q.y, q.z));
+        let truth_inside = inside_closed(&section, &Vector2::new(q.y, q.z));
         if every > 0.05 {
             assert_eq!(foot.distance < 0.0, truth_inside, "{q:?}");
             if truth_inside {
@@ -211,17 +212,6 @@ fn the_loft_s_distances_are_the_nearest_of_every_triangle_and_signed_by_its_sect
         inside > 5 && outside > 50,
         "{inside} inside, {outside} outside"
     );
-}
-
-fn winding_inside(ring: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
-    let mut inside = false;
-    for (i, a) in ring.iter().enumerate() {
-        let b = ring[(i + 1) % ring.len()];
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
 }
 
 #[test]
