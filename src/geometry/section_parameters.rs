@@ -41,6 +41,7 @@
 use nalgebra::Vector2;
 
 use super::circle::{fit_circle, Circle};
+use super::trace::inside_closed;
 
 /// Where the ends are told apart: thickness this fraction of the chord in from each end.
 const EDGE_PROBE: f64 = 0.05;
@@ -419,7 +420,7 @@ impl MeanLine {
             let mut outside = None;
             for k in 1..=500 {
                 let x = from + step * k as f64;
-                if !contains(across.outline, &at(x)) {
+                if !inside_closed(across.outline, &at(x)) {
                     outside = Some(x);
                     break;
                 }
@@ -428,7 +429,7 @@ impl MeanLine {
             let mut outside = outside.ok_or(ParameterError::OpenAt(from))?;
             while (outside - inside).abs() > SEARCH_TOLERANCE_MM {
                 let middle = (inside + outside) / 2.0;
-                if contains(across.outline, &at(middle)) {
+                if inside_closed(across.outline, &at(middle)) {
                     inside = middle;
                 } else {
                     outside = middle;
@@ -513,19 +514,6 @@ fn fitted_peak(samples: &[(f64, f64)], around: f64, half_span: f64) -> Option<(f
         .sqrt();
     let follows = residual_mm <= PEAK_MAX_RESIDUAL_MM;
     (inside && follows).then(|| (at, curve(at)))
-}
-
-/// Whether `p` lies inside the closed polyline `outline` (crossings of a ray towards +x).
-fn contains(outline: &[Vector2<f64>], p: &Vector2<f64>) -> bool {
-    let n = outline.len();
-    let mut inside = false;
-    for i in 0..n {
-        let (a, b) = (outline[i], outline[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
 }
 
 /// The two points farthest apart (all pairs: a section of a few thousand points takes milliseconds).
