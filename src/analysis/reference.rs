@@ -457,6 +457,7 @@ fn profile_faces(profile: &MasterProfile, polynomial: Option<&FitStats>) -> Opti
     let options = FacesFitOptions {
         degree: None,
         method: FitMethod::Orthogonal,
+        split_unfollowed: true,
     };
     match fit_faces(&points, &options) {
         Ok(fitted) => fitted.and_then(|fitted| {

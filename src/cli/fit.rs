@@ -106,7 +106,7 @@ pub fn run(args: &FitIpArgs) -> anyhow::Result<()> {
     let lines = &file.lines;
     let (model, method) = match (file.points, args.stack) {
         (PointSet::Profile(points), false) if with_faces(args, &points) => {
-            match fit_faces_of(args, &args.points.display().to_string(), &points)? {
+            match fit_faces_of(args, &args.points.display().to_string(), &points, true)? {
                 Some(faced) => (ReferenceModel::Faces(faced), method),
                 None => one_polynomial(args, &points, lines)?,
             }
@@ -205,10 +205,12 @@ fn fit_faces_of(
     args: &FitIpArgs,
     label: &str,
     points: &[Vector2<f64>],
+    split_unfollowed: bool,
 ) -> anyhow::Result<Option<FacedIp>> {
     let options = FacesFitOptions {
         degree: args.degree,
         method: args.method.into(),
+        split_unfollowed,
     };
     let Some(fitted) = fit_faces(points, &options).map_err(|e| {
         anyhow!(
@@ -441,7 +443,7 @@ fn fit_faces_stack(
     }
     let mut fitted = Vec::with_capacity(profiles.len());
     for (x, yz, label) in &profiles {
-        fitted.push((*x, fit_faces_of(args, label, yz)?));
+        fitted.push((*x, fit_faces_of(args, label, yz, false)?));
     }
     let without: Vec<String> = fitted
         .iter()

@@ -15,6 +15,7 @@
 
 mod fit;
 mod loft;
+mod refine;
 mod split;
 
 use std::sync::atomic::{AtomicUsize, Ordering};

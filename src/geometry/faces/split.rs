@@ -230,6 +230,65 @@ pub(crate) fn split_at_corners(points: &[Vector2<f64>], corners: &[usize]) -> Ve
     }
 }
 
+/// The positions in `face.indices` of its own span's ends: where it meets the faces before and after it (a smooth
+/// joint lies inside the overlap the face shares with its neighbour).
+pub(crate) fn own_span(face: &FacePoints) -> (usize, usize) {
+    let last = face.indices.len() - 1;
+    let position = |end: FaceEnd, default: usize| {
+        if end.sharp {
+            default
+        } else {
+            face.indices
+                .iter()
+                .position(|&i| i == end.at)
+                .unwrap_or(default)
+        }
+    };
+    (position(face.start, 0), position(face.end, last))
+}
+
+/// The face split in two at a smooth joint at its point `k` (a position in `face.indices`), the two overlapping by
+/// [`JOINT_OVERLAP`] of the perimeter either side of the joint, as the faces of [`split_at_corners`] do, but never
+/// past the face's own span's ends.
+pub(crate) fn split_face(
+    points: &[Vector2<f64>],
+    face: &FacePoints,
+    k: usize,
+    perimeter_mm: f64,
+) -> [FacePoints; 2] {
+    let (first, last) = own_span(face);
+    let at = |j: usize| points[face.indices[j]];
+    let overlap = JOINT_OVERLAP * perimeter_mm;
+    let mut before = k;
+    let mut length = 0.0;
+    while before > first && length < overlap {
+        length += (at(before) - at(before - 1)).norm();
+        before -= 1;
+    }
+    let mut after = k;
+    length = 0.0;
+    while after < last && length < overlap {
+        length += (at(after + 1) - at(after)).norm();
+        after += 1;
+    }
+    let joint = FaceEnd {
+        at: face.indices[k],
+        sharp: false,
+    };
+    [
+        FacePoints {
+            indices: face.indices[..=after].to_vec(),
+            start: face.start,
+            end: joint,
+        },
+        FacePoints {
+            indices: face.indices[before..].to_vec(),
+            start: joint,
+            end: face.end,
+        },
+    ]
+}
+
 /// Outward unit normals of a face's points (in order along a counter-clockwise profile of perimeter
 /// `perimeter_mm`), each from the chord between the face's points half a span either side (one-sided at the face's
 /// ends, so that no normal looks across a sharp edge to the other face).
@@ -341,6 +400,47 @@ mod tests {
             "{k} of {}",
             nose.len()
         );
+    }
+
+    #[test]
+    fn a_face_split_in_two_keeps_its_ends_and_overlaps_round_the_new_joint() {
+        let points = section("2412", 100.0, 400);
+        let total = perimeter(&points);
+        let nose = &split_at_corners(&points, &[0])[1];
+        let (first, last) = own_span(nose);
+        assert_eq!(nose.indices[first], nose.start.at);
+        assert_eq!(nose.indices[last], nose.end.at);
+        let k = first + (last - first) / 4;
+        let [before, after] = split_face(&points, nose, k, total);
+        assert_eq!((before.start, after.end), (nose.start, nose.end));
+        let joint = FaceEnd {
+            at: nose.indices[k],
+            sharp: false,
+        };
+        assert_eq!((before.end, after.start), (joint, joint));
+        // Together they hold the face's points, each of them once outside the overlap.
+        assert_eq!(before.indices[0], nose.indices[0]);
+        assert_eq!(after.indices.last(), nose.indices.last());
+        let overlap_start = nose.indices.len() - after.indices.len();
+        assert_eq!(&nose.indices[overlap_start..], &after.indices[..]);
+        assert_eq!(&nose.indices[..before.indices.len()], &before.indices[..]);
+        // The overlap runs about JOINT_OVERLAP of the perimeter either side of the joint, within the own span.
+        let length = |from: usize, to: usize| -> f64 {
+            (from..to)
+                .map(|j| (points[nose.indices[j + 1]] - points[nose.indices[j]]).norm())
+                .sum()
+        };
+        let ahead = length(k, before.indices.len() - 1);
+        let behind = length(overlap_start, k);
+        for side in [ahead, behind] {
+            assert!(
+                side >= JOINT_OVERLAP * total && side < JOINT_OVERLAP * total + 2.0,
+                "{side} mm of overlap"
+            );
+        }
+        // Split near its own span's start, the overlap stops there.
+        let [_, late] = split_face(&points, nose, first + 2, total);
+        assert_eq!(late.indices.len(), nose.indices.len() - first);
     }
 
     #[test]

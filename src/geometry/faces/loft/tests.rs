@@ -37,6 +37,7 @@ fn twisted_profile(x: f64, seed: u64, twist: f64) -> FacedSection {
     let options = FacesFitOptions {
         degree: None,
         method: FitMethod::Orthogonal,
+        split_unfollowed: false,
     };
     let fitted = fit_faces(&points, &options)
         .unwrap()
