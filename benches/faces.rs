@@ -19,6 +19,7 @@ fn faces(c: &mut Criterion) {
     let options = FacesFitOptions {
         degree: None,
         method: FitMethod::Orthogonal,
+        split_unfollowed: true,
     };
     c.bench_function(
         "fit a NACA 2412 face by face (400 points, degrees by held-out points)",

@@ -1,15 +1,17 @@
 //! The edge-aware model's accuracy figures of BENCHMARKS.md (issue 15): NACA 2412, 4412, 6412 and 0006 sections
 //! with sharp trailing edges at 100 and 250 mm chord, 400 points with 2 um of Gaussian noise along the normal, over
-//! 20 noise draws each. Each draw is fitted twice: face by face (`fit ip`'s default, degrees chosen by held-out
+//! 20 noise draws each. Each draw is fitted face by face (`fit ip`'s default, degrees chosen by held-out
 //! points) and as one degree-8 polynomial (`--edges none --degree 8`). For each: the largest distance of the true
 //! section (20 000 points, cosine-spaced, so dense at the edges) to the model over all draws, the largest within 1%
 //! of chord of the leading and of the trailing edge, the worst RMS, and the spread over draws (at each true point, the largest less the
 //! smallest signed distance over the draws, at worst).
 //!
-//!     cargo run --release --example faces_accuracy [-- DRAWS [FIRST_DRAW [DEGREE]]]
+//!     cargo run --release --example faces_accuracy [-- DRAWS [FIRST_DRAW [DEGREE|auto [SECTIONS [CHORDS]]]]]
 //!
 //! The draws are seeded FIRST_DRAW (0 unless given) onwards; DEGREE fixes every face's degree instead of choosing
-//! it by held-out points.
+//! it by held-out points; SECTIONS (e.g. 9322,7606) and CHORDS (mm, e.g. 100,250) replace the four sections and
+//! two chords. Each draw is also fitted with no face split where its polynomial does not follow it ("faces, none
+//! split"), as before stop 53.
 
 use nalgebra::Vector2;
 use rand::SeedableRng;
@@ -86,13 +88,23 @@ fn main() {
         .map_or(0, |a| a.parse().expect("the first draw's seed"));
     let degree: Option<usize> = std::env::args()
         .nth(3)
-        .map(|a| a.parse().expect("a degree for every face"));
+        .filter(|a| a != "auto")
+        .map(|a| a.parse().expect("a degree for every face, or auto"));
+    let sections: Vec<String> = std::env::args().nth(4).map_or_else(
+        || SECTIONS.map(String::from).to_vec(),
+        |a| a.split(',').map(String::from).collect(),
+    );
+    let chords: Vec<f64> = std::env::args().nth(5).map_or(CHORDS_MM.to_vec(), |a| {
+        a.split(',')
+            .map(|c| c.parse().expect("chords in mm"))
+            .collect()
+    });
     println!("{draws} draws of {POINTS} points (seeds {first_draw} to {}), sigma {} um; distances of the true section to the model, um", first_draw + draws - 1, SIGMA_MM * 1000.0);
     println!();
     println!("| section | chord (mm) | model | max (its draw) | max within 1% of chord of the leading edge | of the trailing edge | worst RMS | spread over draws | faces' edge off the true edge: RMS, most inward | faces' degrees |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    for digits in SECTIONS {
-        for chord in CHORDS_MM {
+    for digits in &sections {
+        for &chord in &chords {
             let foil = Naca4::from_digits(digits, chord, true).expect("digits");
             let truth: Vec<Vector2<f64>> =
                 foil.points(20_000).into_iter().map(Vector2::from).collect();
@@ -100,6 +112,10 @@ fn main() {
                 foil.points(POINTS).into_iter().map(Vector2::from).collect();
             let normals = ordered_profile_normals(&clean);
             let mut faces = Campaign {
+                rows: Vec::new(),
+                seeds: Vec::new(),
+            };
+            let mut unsplit = Campaign {
                 rows: Vec::new(),
                 seeds: Vec::new(),
             };
@@ -121,6 +137,7 @@ fn main() {
                 let options = FacesFitOptions {
                     degree,
                     method: FitMethod::Orthogonal,
+                    split_unfollowed: true,
                 };
                 let fitted = fit_faces(&measured, &options)
                     .expect("the faces fit")
@@ -138,7 +155,23 @@ fn main() {
                     .find(|join| join.sharp)
                     .expect("the sharp trailing edge's join");
                 edge_off.push(edge.point[0] - chord);
+                let three = fit_faces(
+                    &measured,
+                    &FacesFitOptions {
+                        split_unfollowed: false,
+                        ..options
+                    },
+                )
+                .expect("the faces fit")
+                .expect("a sharp trailing edge");
+                unsplit.rows.push(
+                    truth
+                        .iter()
+                        .map(|p| three.model.foot(p).expect("a foot").distance)
+                        .collect(),
+                );
                 faces.seeds.push(draw);
+                unsplit.seeds.push(draw);
                 single.seeds.push(draw);
                 faces.rows.push(
                     truth
@@ -154,11 +187,12 @@ fn main() {
                 .expect("the single fit");
                 let samples = ZeroSetSamples::new(&one.model, &one.domain.scaled(2.0), 1024);
                 let exact = ExactDistance::new(&one.model, &samples);
+                // A true point with no foot on the polynomial's zero set (it has none near) counts as infinitely far.
                 single.rows.push(
                     exact
                         .feet_along_scan(&truth)
                         .into_iter()
-                        .map(|f| f.expect("a foot").distance)
+                        .map(|f| f.map_or(f64::INFINITY, |f| f.distance))
                         .collect(),
                 );
                 eprint!(".");
@@ -174,6 +208,10 @@ fn main() {
                 edge_rms * 1000.0,
                 most_inward * 1000.0,
                 degrees.join(", ")
+            );
+            println!(
+                "| NACA {digits} | {chord} | faces, none split | {} | | |",
+                unsplit.summary(&truth, chord)
             );
             println!(
                 "| NACA {digits} | {chord} | one polynomial, degree 8 | {} | | |",
