@@ -45,8 +45,8 @@ pub struct FacesFitOptions {
     pub degree: Option<usize>,
     pub method: FitMethod,
     /// Whether a face its polynomial does not follow is split in two at a smooth joint (see
-    /// [`joint_for_unfollowed`](super::refine::joint_for_unfollowed)). A stack's profiles are not: its loft pairs faces profile to profile, so every
-    /// profile must have its joints at the same places.
+    /// [`joint_for_unfollowed`](super::refine::joint_for_unfollowed)). A stack's profiles are not: its loft pairs
+    /// faces profile to profile, so every profile must have its joints at the same places.
     pub split_unfollowed: bool,
 }
 
@@ -55,7 +55,7 @@ pub struct FittedFaces {
     /// Each face's fit, counter-clockwise round the part.
     pub faces: Vec<Fitted<2>>,
     /// For each face, the held-out RMS distance (mm) of each candidate degree tried, when the degree was chosen.
-    pub held_out: Vec<Vec<(usize, f64)>>,
+    pub held_out: Vec<HeldOut>,
     /// How many of the profile's points each face was fitted to (its fit's statistics count a sharp edge's point
     /// as often as it weighs).
     pub face_points: Vec<usize>,
